@@ -1,0 +1,127 @@
+//! Typed errors of the library, one enum per stage, gathered in [`Error`].
+//!
+//! Every variant carries what the user must fix: the file, the physical group,
+//! the element, the line, and where possible the fix itself. `anyhow` context is
+//! added only in `main.rs`.
+
+use std::path::PathBuf;
+use thiserror::Error;
+
+/// Any failure of a jointquake stage.
+#[derive(Debug, Error)]
+pub enum Error {
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Step(#[from] StepError),
+    #[error(transparent)]
+    Gmsh(#[from] GmshError),
+    #[error(transparent)]
+    Interface(#[from] InterfaceError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// Reading a `.msh` file or looking up its parts.
+#[derive(Debug, Error)]
+pub enum MeshError {
+    #[error("cannot read mesh file {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path} is not a valid MSH 4.1 file: {reason}. Re-export it from Gmsh with `-format msh41` (ASCII or binary).")]
+    Malformed { path: PathBuf, reason: String },
+    #[error("{path}: element {element} has unsupported type {kind}. jointquake reads tet4 and hex8 volumes, tri3 and quad4 faces; mesh with first-order elements (`-order 1`).")]
+    UnsupportedElement { path: PathBuf, element: u64, kind: String },
+    #[error("{path}: element {element} refers to node {node}, which is not in the $Nodes section")]
+    MissingNode { path: PathBuf, element: u64, node: u64 },
+    #[error("unknown physical group \"{name}\"{}. Groups in the mesh: {}", dim.map(|d| format!(" of dimension {d}")).unwrap_or_default(), available.join(", "))]
+    UnknownGroup { name: String, dim: Option<usize>, available: Vec<String> },
+    #[error("{path}: physical group \"{group}\": element {element} is inverted (Jacobian {jacobian:.3e} at a corner). Fix the node order or the geometry orientation in the .geo (e.g. `ReverseMesh`).")]
+    InvertedElement { path: PathBuf, group: String, element: u64, jacobian: f64 },
+    #[error("{path}: node {node} has a non-finite coordinate")]
+    NonFiniteNode { path: PathBuf, node: u64 },
+}
+
+/// Loading and validating a scene file.
+#[derive(Debug, Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("scene {path}: {message}")]
+    Parse { path: PathBuf, message: String },
+    #[error("scene {path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+/// Reading an acceleration record.
+#[derive(Debug, Error)]
+pub enum RecordError {
+    #[error("cannot read record {path}: {source}. Check the `record` path in the scene (relative paths are relative to the scene file).")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("record {path}, line {line}: {message}")]
+    Line { path: PathBuf, line: usize, message: String },
+    #[error("record {path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+/// Building the model (materials, elements, boundary conditions, loads).
+#[derive(Debug, Error)]
+pub enum ModelError {
+    #[error("{0}")]
+    Invalid(String),
+    #[error("time step dt = {dt:.4e} s is above the stability limit {limit:.4e} s (critical element {element} in group \"{group}\"). Use dt <= {limit:.4e} s or `\"courant\": 0.9` in the scene's time section.")]
+    UnstableStep { dt: f64, limit: f64, element: u64, group: String },
+}
+
+/// Failure during time stepping.
+#[derive(Debug, Error)]
+pub enum StepError {
+    #[error("non-finite {what} at step {step} (t = {t:.6} s), node {node} at ({:.3}, {:.3}, {:.3}). Likely cause: {cause}", x[0], x[1], x[2])]
+    NonFinite { what: String, step: usize, t: f64, node: usize, x: [f64; 3], cause: String },
+    #[error("energy balance lost at step {step} (t = {t:.6} s): error {error:.3e} of the energy scale, limit {limit:.1e}. Largest velocity at node {node} at ({:.3}, {:.3}, {:.3}). Likely cause: {cause}", x[0], x[1], x[2])]
+    EnergyGrowth { step: usize, t: f64, error: f64, limit: f64, node: usize, x: [f64; 3], cause: String },
+    #[error("{0}")]
+    Contact(String),
+}
+
+/// Running the gmsh command line.
+#[derive(Debug, Error)]
+pub enum GmshError {
+    #[error("cannot start gmsh ({exe}): {source}. Run `make venv` to install the gmsh wheel into .venv, or set GMSH=/path/to/gmsh.")]
+    Spawn { exe: String, source: std::io::Error },
+    #[error("gmsh failed on {geo} (log: {log}):\n{message}")]
+    Failed { geo: PathBuf, log: PathBuf, message: String },
+    #[error("geometry file {path} does not exist")]
+    MissingGeo { path: PathBuf },
+    #[error("cannot write {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+}
+
+/// Building joint interfaces (tagger).
+#[derive(Debug, Error)]
+pub enum InterfaceError {
+    #[error("joint \"{joint}\": {message}")]
+    Invalid { joint: String, message: String },
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+}
+
+/// Writing results.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    #[error("cannot write {path}: {message}")]
+    Write { path: PathBuf, message: String },
+}
+
+impl OutputError {
+    pub fn write(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
+        OutputError::Write { path: path.into(), message: e.to_string() }
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
