@@ -24,5 +24,6 @@
 
 pub mod error;
 pub mod mesh;
+pub mod output;
 
 pub use error::{Error, Result};

@@ -1,0 +1,5 @@
+//! One integration-test binary, a module per topic (mesh, tagging, dynamics, contact
+//! validation, studies, bad input, regressions named after the bug they pin).
+//! Physics tests state their reference and tolerance in a comment.
+
+mod common;
