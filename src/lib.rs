@@ -22,8 +22,13 @@
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages.
 
+pub mod dynamics;
 pub mod error;
+pub mod gmsh;
 pub mod mesh;
+pub mod model;
 pub mod output;
+pub mod pipeline;
+pub mod scene;
 
 pub use error::{Error, Result};

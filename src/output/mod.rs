@@ -5,3 +5,21 @@
 //! rewritten after every frame, so a run killed at any point leaves a readable series.
 
 pub mod vtu;
+pub mod frames;
+pub mod history;
+pub mod pvd;
+
+/// Principal stresses σ1 ≥ σ2 ≥ σ3 [Pa] of a Voigt stress (xx, yy, zz, xy, yz, zx).
+pub fn principal_stresses(s: &[f64; 6]) -> [f64; 3] {
+    let m = nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
+    let mut e: Vec<f64> = nalgebra::SymmetricEigen::new(m).eigenvalues.iter().copied().collect();
+    e.sort_by(|a, b| b.total_cmp(a));
+    [e[0], e[1], e[2]]
+}
+
+/// von Mises equivalent stress [Pa].
+pub fn von_mises(s: &[f64; 6]) -> f64 {
+    (0.5 * ((s[0] - s[1]).powi(2) + (s[1] - s[2]).powi(2) + (s[2] - s[0]).powi(2))
+        + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]))
+        .sqrt()
+}

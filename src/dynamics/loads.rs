@@ -1,0 +1,177 @@
+//! External loads: gravity, uniform base acceleration (relative form), tractions, nodal forces.
+//!
+//! Relative form: with the base moving with acceleration a_g(t), the displacements solved for are
+//! relative to the base, fixed boundary nodes have relative displacement 0, and every node with
+//! mass carries the effective force −m a_g(t). Records are already in m/s² ([`super::record`]).
+
+use super::record::Record;
+use crate::error::{Error, ModelError};
+use crate::mesh::CellKind;
+use crate::model::Model;
+use crate::scene::Scene;
+use nalgebra::Vector3;
+
+/// One component of the base motion: a record times a direction (unit vector × scale).
+#[derive(Clone, Debug)]
+pub struct BaseMotion {
+    pub record: Record,
+    /// Direction × scale factor (dimensionless): a_g += dir · record(t).
+    pub dir: [f64; 3],
+    pub scale: f64,
+}
+
+/// A fixed nodal force pattern with a linear ramp [s] (0 = step).
+#[derive(Clone, Debug)]
+pub struct ForcePattern {
+    /// (node, force [N])
+    pub forces: Vec<(usize, [f64; 3])>,
+    pub ramp: f64,
+}
+
+/// All loads of a scene, resolved against the model.
+#[derive(Clone, Debug, Default)]
+pub struct Loads {
+    /// Gravity acceleration vector [m/s²].
+    pub gravity: Option<[f64; 3]>,
+    pub base: Vec<BaseMotion>,
+    pub patterns: Vec<ForcePattern>,
+}
+
+impl Loads {
+    /// Resolve the scene's loads on the model (groups, records, snapping).
+    pub fn build(model: &Model, scene: &Scene) -> Result<(Loads, Vec<String>), Error> {
+        let mut notes = Vec::new();
+        let gravity = scene.loads.gravity.as_ref().map(|g| {
+            let d = Vector3::from(g.direction).normalize() * g.g;
+            [d[0], d[1], d[2]]
+        });
+        let mut base = Vec::new();
+        for b in &scene.loads.base {
+            let record = Record::read(&b.record, scene.g)?;
+            let d = Vector3::from(b.direction).normalize();
+            let scale = match (b.scale, b.pga) {
+                (_, Some(pga)) => {
+                    let peak = record.peak();
+                    if peak == 0.0 {
+                        return Err(ModelError::Invalid(format!("record {} is all zeros: cannot scale it to pga {pga} g", b.record.display())).into());
+                    }
+                    pga * scene.g / peak
+                }
+                (Some(s), None) => s,
+                (None, None) => 1.0,
+            };
+            notes.push(format!(
+                "record {}: {} samples, dt {} s, PGA {:.4} g × {:.4} along ({:.3}, {:.3}, {:.3})",
+                b.record.display(),
+                record.accel.len(),
+                record.dt,
+                record.peak() / scene.g,
+                scale,
+                d[0],
+                d[1],
+                d[2]
+            ));
+            base.push(BaseMotion { record, dir: [d[0] * scale, d[1] * scale, d[2] * scale], scale });
+        }
+        let mut patterns = Vec::new();
+        for t in &scene.loads.traction {
+            let g = model.mesh.group_of_dim(&t.group, 2)?;
+            let mut forces: Vec<(usize, [f64; 3])> = Vec::new();
+            for &c in &g.cells {
+                let cell = &model.mesh.cells[c];
+                let x: Vec<Vector3<f64>> = cell.nodes().iter().map(|&n| model.mesh.x(n as usize)).collect();
+                let w = face_node_areas(cell.kind, &x);
+                for (a, &n) in cell.nodes().iter().enumerate() {
+                    forces.push((n as usize, [t.traction[0] * w[a], t.traction[1] * w[a], t.traction[2] * w[a]]));
+                }
+            }
+            patterns.push(ForcePattern { forces, ramp: t.ramp });
+        }
+        for nf in &scene.loads.nodal {
+            let (node, dist) = model.mesh.nearest_node(nf.point).ok_or_else(|| ModelError::Invalid("empty mesh".into()))?;
+            notes.push(format!("nodal force at ({:?}) snapped to node {} at distance {:.3e} m", nf.point, model.mesh.node_tags[node], dist));
+            patterns.push(ForcePattern { forces: vec![(node, nf.force)], ramp: nf.ramp });
+        }
+        Ok((Loads { gravity, base, patterns }, notes))
+    }
+
+    /// Ground acceleration vector a_g(t) [m/s²].
+    pub fn ground_acceleration(&self, t: f64) -> [f64; 3] {
+        let mut a = [0.0; 3];
+        for b in &self.base {
+            let v = b.record.at(t);
+            for i in 0..3 {
+                a[i] += b.dir[i] * v;
+            }
+        }
+        a
+    }
+
+    /// End of the longest record [s] (0 without records).
+    pub fn record_end(&self) -> f64 {
+        self.base.iter().map(|b| b.record.t_end()).fold(0.0, f64::max)
+    }
+
+    /// f = F_ext(t) (overwritten): m (g − a_g(t)) on every node plus the force patterns.
+    /// `with_gravity`/`with_dynamic` select the parts (gravity alone during relaxation).
+    pub fn external_force_into(&self, model: &Model, t: f64, with_gravity: bool, with_dynamic: bool, f: &mut [f64]) {
+        let mut acc = [0.0; 3];
+        if with_gravity {
+            if let Some(g) = self.gravity {
+                acc = g;
+            }
+        }
+        if with_dynamic {
+            let ag = self.ground_acceleration(t);
+            for i in 0..3 {
+                acc[i] -= ag[i];
+            }
+        }
+        for (n, &m) in model.mass.iter().enumerate() {
+            f[3 * n] = m * acc[0];
+            f[3 * n + 1] = m * acc[1];
+            f[3 * n + 2] = m * acc[2];
+        }
+        if with_dynamic {
+            for p in &self.patterns {
+                let s = if p.ramp > 0.0 { (t / p.ramp).clamp(0.0, 1.0) } else { 1.0 };
+                for &(n, fv) in &p.forces {
+                    for i in 0..3 {
+                        f[3 * n + i] += s * fv[i];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// ∫ N_a dA for each node of a tri3 / quad4 face (2×2 Gauss for quads, exact for bilinear).
+pub fn face_node_areas(kind: CellKind, x: &[Vector3<f64>]) -> Vec<f64> {
+    match kind {
+        CellKind::Tri3 => {
+            let a = 0.5 * (x[1] - x[0]).cross(&(x[2] - x[0])).norm();
+            vec![a / 3.0; 3]
+        }
+        CellKind::Quad4 => {
+            let gp = 1.0 / 3f64.sqrt();
+            let r = crate::mesh::cell::QUAD4_REF;
+            let mut w = vec![0.0; 4];
+            for &s in &[-gp, gp] {
+                for &t in &[-gp, gp] {
+                    let mut dxs = Vector3::zeros();
+                    let mut dxt = Vector3::zeros();
+                    for a in 0..4 {
+                        dxs += x[a] * 0.25 * r[a][0] * (1.0 + t * r[a][1]);
+                        dxt += x[a] * 0.25 * r[a][1] * (1.0 + s * r[a][0]);
+                    }
+                    let j = dxs.cross(&dxt).norm();
+                    for a in 0..4 {
+                        w[a] += j * 0.25 * (1.0 + s * r[a][0]) * (1.0 + t * r[a][1]);
+                    }
+                }
+            }
+            w
+        }
+        _ => vec![0.0; x.len()],
+    }
+}

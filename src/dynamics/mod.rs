@@ -1,0 +1,329 @@
+//! Explicit dynamics: the central-difference scheme of design §4, gravity equilibrium, energy.
+//!
+//! Scheme (lumped M, Rayleigh C = αM + βK, one-sided velocity in the damping term):
+//!
+//! ```text
+//!   M (u[n+1] − 2u[n] + u[n−1]) / dt² + C (u[n] − u[n−1]) / dt + K u[n] = F[n] + R[n]
+//! ```
+//!
+//! so u[n+1] = 2u[n] − u[n−1] + dt² M⁻¹ (F[n] − K (u[n] + β v_b) − α M v_b) with
+//! v_b = (u[n] − u[n−1]) / dt, followed by the contact correction u[n+1] += dt² M⁻¹ R
+//! ([`Correction`]). Fixed components keep relative displacement 0.
+//!
+//! Owns: [`State`] (what changes: t, u[n], u[n−1], energy account) and [`ExplicitSolver`]
+//! (scratch buffers only). Energy: E_err = KE + SE + D_α − E0 − W_ext − W_contact, with
+//! SE = ½ uᵀKu evaluated directly; stiffness-proportional dissipation is not subtracted, so
+//! with β > 0 the error drifts negative by that dissipation. Energy *appearing* (E_err above
+//! `energy_tolerance` × the energy scale) stops the run: it is the signature of instability.
+
+pub mod loads;
+pub mod record;
+
+use crate::error::StepError;
+use crate::model::Model;
+use loads::Loads;
+
+/// Running energy account of the dynamic stage [J].
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub strain: f64,
+    pub external_work: f64,
+    pub contact_work: f64,
+    pub mass_damping: f64,
+    /// KE + SE at the start of the stage.
+    pub initial: f64,
+    /// Largest |KE + SE| and |W_ext| seen: the scale of the relative error.
+    pub scale: f64,
+    /// Latest relative error and its largest value.
+    pub error: f64,
+    pub max_error: f64,
+}
+
+/// What changes during a run.
+#[derive(Clone, Debug)]
+pub struct State {
+    /// Index of the step that produces u[n+1] next.
+    pub step: usize,
+    /// Time of `u` [s].
+    pub t: f64,
+    /// u[n] (relative displacements, m), 3 per node.
+    pub u: Vec<f64>,
+    /// u[n−1].
+    pub u_prev: Vec<f64>,
+    pub energy: Energy,
+}
+
+impl State {
+    pub fn at_rest(model: &Model) -> State {
+        let n = 3 * model.n_nodes();
+        State { step: 0, t: 0.0, u: vec![0.0; n], u_prev: vec![0.0; n], energy: Energy::default() }
+    }
+}
+
+/// Result of a contact (or other constraint) correction of one step.
+#[derive(Clone, Debug, Default)]
+pub struct CorrectionInfo {
+    /// Work of the correction forces over the step, Δu_c · R [J].
+    pub work: f64,
+    /// Gauss–Seidel sweeps used.
+    pub iterations: usize,
+}
+
+/// A correction applied to the contact-free prediction u[n+1] (the dynamic contact force).
+pub trait Correction {
+    /// `u_prev` = u[n−1], `u` = u[n], `u_next` = predicted u[n+1] (corrected in place).
+    fn correct(&mut self, model: &Model, t_next: f64, dt: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> Result<CorrectionInfo, StepError>;
+}
+
+/// Non-fatal information about one step.
+#[derive(Clone, Debug, Default)]
+pub struct StepInfo {
+    pub correction: CorrectionInfo,
+}
+
+/// Which loads a step applies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stage {
+    /// Gravity only, no damping (dynamic relaxation).
+    Relaxation,
+    /// Everything: gravity, base motion, force patterns, Rayleigh damping.
+    Dynamic,
+}
+
+/// Scratch buffers and the step size. Holds nothing that outlives a step except `u_nm1`
+/// (u[n−1] after the shift, kept so that outputs can use central differences at t[n]).
+pub struct ExplicitSolver {
+    pub dt: f64,
+    f_int: Vec<f64>,
+    f_ext: Vec<f64>,
+    w: Vec<f64>,
+    u_next: Vec<f64>,
+    /// After a step: u[n−1] of the step just taken (state.u_prev is u[n], state.u is u[n+1]).
+    pub u_nm1: Vec<f64>,
+    /// Evaluate the energy balance every this many steps. Default 10.
+    pub energy_stride: usize,
+    /// Relative energy-growth limit (from the scene). Default 0.05.
+    pub energy_tolerance: f64,
+}
+
+impl ExplicitSolver {
+    pub fn new(model: &Model, dt: f64, energy_tolerance: f64) -> ExplicitSolver {
+        let n = 3 * model.n_nodes();
+        ExplicitSolver {
+            dt,
+            f_int: vec![0.0; n],
+            f_ext: vec![0.0; n],
+            w: vec![0.0; n],
+            u_next: vec![0.0; n],
+            u_nm1: vec![0.0; n],
+            energy_stride: 10,
+            energy_tolerance,
+        }
+    }
+
+    /// Internal force of the last step (K u[n], or K(u[n] + β v_b) when β > 0).
+    pub fn internal_force(&self) -> &[f64] {
+        &self.f_int
+    }
+
+    /// Advance `state` from t[n] to t[n+1].
+    pub fn step<'c>(
+        &mut self,
+        model: &Model,
+        loads: &Loads,
+        state: &mut State,
+        stage: Stage,
+        correction: Option<&mut (dyn Correction + 'c)>,
+    ) -> Result<StepInfo, StepError> {
+        let dt = self.dt;
+        let dynamic = stage == Stage::Dynamic;
+        loads.external_force_into(model, state.t, true, dynamic, &mut self.f_ext);
+        let (alpha, beta) = if dynamic { (model.alpha, model.beta) } else { (0.0, 0.0) };
+        if beta > 0.0 {
+            let c = beta / dt;
+            for ((w, &u), &up) in self.w.iter_mut().zip(&state.u).zip(&state.u_prev) {
+                *w = u + c * (u - up);
+            }
+            model.internal_forces_into(&self.w, &mut self.f_int);
+        } else {
+            model.internal_forces_into(&state.u, &mut self.f_int);
+        }
+        let dt2 = dt * dt;
+        for node in 0..model.n_nodes() {
+            let m = model.mass[node];
+            let fx = model.fixed[node];
+            for c in 0..3 {
+                let i = 3 * node + c;
+                if fx & (1 << c) != 0 {
+                    self.u_next[i] = 0.0;
+                    continue;
+                }
+                let vb = (state.u[i] - state.u_prev[i]) / dt;
+                let a = (self.f_ext[i] - self.f_int[i]) / m - alpha * vb;
+                self.u_next[i] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * a;
+            }
+        }
+        let mut info = StepInfo::default();
+        if let Some(c) = correction {
+            info.correction = c.correct(model, state.t + dt, dt, &state.u_prev, &state.u, &mut self.u_next)?;
+        }
+        // energy increments over the step: Δu_c = (u[n+1] − u[n−1]) / 2
+        if dynamic {
+            let e = &mut state.energy;
+            let mut wext = 0.0;
+            let mut damp = 0.0;
+            for i in 0..self.u_next.len() {
+                let du = 0.5 * (self.u_next[i] - state.u_prev[i]);
+                wext += du * self.f_ext[i];
+                if alpha > 0.0 {
+                    let vb = (state.u[i] - state.u_prev[i]) / dt;
+                    damp += du * alpha * model.mass[i / 3] * vb;
+                }
+            }
+            e.external_work += wext;
+            e.mass_damping += damp;
+            e.contact_work += info.correction.work;
+        }
+        // non-finite check (one pass)
+        if !self.u_next.iter().fold(0.0, |s, v| s + v * 0.0).is_finite() {
+            let i = self.u_next.iter().position(|v| !v.is_finite()).unwrap_or(0);
+            let node = i / 3;
+            return Err(StepError::NonFinite {
+                what: "displacement".into(),
+                step: state.step,
+                t: state.t,
+                node: model.mesh.node_tags[node] as usize,
+                x: model.mesh.nodes[node],
+                cause: "the time step is too large for the stiffest element or contact, or a load/record holds a non-finite value".into(),
+            });
+        }
+        // shift: u_nm1 ← u[n−1], u_prev ← u[n], u ← u[n+1]
+        std::mem::swap(&mut self.u_nm1, &mut state.u_prev);
+        std::mem::swap(&mut state.u_prev, &mut state.u);
+        std::mem::swap(&mut state.u, &mut self.u_next);
+        state.step += 1;
+        state.t += dt;
+        if dynamic && (state.step % self.energy_stride == 0) {
+            self.check_energy(model, state)?;
+        }
+        Ok(info)
+    }
+
+    /// Kinetic and strain energy at t[n] (the middle of the last step) [J].
+    pub fn kinetic_and_strain(&mut self, model: &Model, state: &State) -> (f64, f64) {
+        let dt = self.dt;
+        let mut ke = 0.0;
+        for i in 0..state.u.len() {
+            let v = (state.u[i] - self.u_nm1[i]) / (2.0 * dt);
+            ke += 0.5 * model.mass[i / 3] * v * v;
+        }
+        model.internal_forces_into(&state.u_prev, &mut self.w);
+        let se = 0.5 * state.u_prev.iter().zip(&self.w).map(|(u, f)| u * f).sum::<f64>();
+        (ke, se)
+    }
+
+    /// Start the energy account of the dynamic stage from the current state.
+    pub fn start_energy(&mut self, model: &Model, state: &mut State) {
+        self.u_nm1.copy_from_slice(&state.u_prev);
+        // at rest after relaxation: KE = 0, SE = ½ uᵀKu
+        model.internal_forces_into(&state.u, &mut self.w);
+        let se = 0.5 * state.u.iter().zip(&self.w).map(|(u, f)| u * f).sum::<f64>();
+        state.energy = Energy { strain: se, initial: se, scale: se.abs(), ..Energy::default() };
+    }
+
+    fn check_energy(&mut self, model: &Model, state: &mut State) -> Result<(), StepError> {
+        let (ke, se) = self.kinetic_and_strain(model, state);
+        let e = &mut state.energy;
+        e.kinetic = ke;
+        e.strain = se;
+        e.scale = e.scale.max((ke + se).abs()).max(e.external_work.abs()).max(e.contact_work.abs());
+        let bal = ke + se + e.mass_damping - e.initial - e.external_work - e.contact_work;
+        e.error = if e.scale > 0.0 { bal / e.scale } else { 0.0 };
+        if e.error.abs() > e.max_error.abs() {
+            e.max_error = e.error;
+        }
+        if e.error > self.energy_tolerance && e.scale > 1e-300 {
+            let (node, _) = (0..model.n_nodes())
+                .map(|n| {
+                    let v: f64 = (0..3).map(|c| (state.u[3 * n + c] - self.u_nm1[3 * n + c]).powi(2)).sum();
+                    (n, v)
+                })
+                .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
+            return Err(StepError::EnergyGrowth {
+                step: state.step,
+                t: state.t,
+                error: e.error,
+                limit: self.energy_tolerance,
+                node: model.mesh.node_tags[node] as usize,
+                x: model.mesh.nodes[node],
+                cause: "instability: dt too close to the stability limit for a contact or penalty spring, or contact forces doing work (check the joint law and the time step)".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Outcome of gravity equilibration.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct EquilibriumInfo {
+    pub steps: usize,
+    /// ‖M a‖ / ‖F_gravity‖ over free components at the end.
+    pub residual: f64,
+    pub converged: bool,
+    pub resets: usize,
+}
+
+/// Dynamic relaxation with kinetic damping: undamped steps under gravity; whenever the kinetic
+/// energy passes a peak the velocities are zeroed. Stops when the out-of-balance force
+/// ‖M a‖ (gravity, elastic and contact forces together) falls below `tol` × ‖F_gravity‖.
+pub fn relax_gravity<'c>(
+    model: &Model,
+    loads: &Loads,
+    solver: &mut ExplicitSolver,
+    state: &mut State,
+    mut correction: Option<&mut (dyn Correction + 'c)>,
+    tol: f64,
+    max_steps: usize,
+) -> Result<EquilibriumInfo, StepError> {
+    let mut fg = vec![0.0; 3 * model.n_nodes()];
+    loads.external_force_into(model, 0.0, true, false, &mut fg);
+    let norm_f: f64 = fg.iter().enumerate().filter(|(i, _)| model.is_free(i / 3, i % 3)).map(|(_, f)| f * f).sum::<f64>().sqrt();
+    if norm_f == 0.0 {
+        return Ok(EquilibriumInfo { steps: 0, residual: 0.0, converged: true, resets: 0 });
+    }
+    let dt = solver.dt;
+    let mut ke_prev = 0.0;
+    let mut resets = 0;
+    let mut residual = f64::INFINITY;
+    for k in 0..max_steps {
+        solver.step(model, loads, state, Stage::Relaxation, correction.as_deref_mut())?;
+        // after the step: u_nm1 = u[n−1], u_prev = u[n], u = u[n+1]
+        let mut ke = 0.0;
+        let mut r2 = 0.0;
+        for i in 0..state.u.len() {
+            let m = model.mass[i / 3];
+            let v = (state.u[i] - state.u_prev[i]) / dt;
+            ke += 0.5 * m * v * v;
+            if model.is_free(i / 3, i % 3) {
+                let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
+                r2 += (m * a).powi(2);
+            }
+        }
+        residual = r2.sqrt() / norm_f;
+        if residual < tol && k > 2 {
+            state.u_prev.copy_from_slice(&state.u);
+            return Ok(EquilibriumInfo { steps: k + 1, residual, converged: true, resets });
+        }
+        if ke < ke_prev {
+            // kinetic-energy peak passed: restart from rest at the current position
+            state.u_prev.copy_from_slice(&state.u);
+            resets += 1;
+            ke_prev = 0.0;
+        } else {
+            ke_prev = ke;
+        }
+    }
+    state.u_prev.copy_from_slice(&state.u);
+    Ok(EquilibriumInfo { steps: max_steps, residual, converged: false, resets })
+}

@@ -1,0 +1,304 @@
+//! The recipe: the only function that sequences the stages (scene → mesh → model → loads →
+//! equilibrium → dynamic run → outputs). Each stage is timed into `summary.json`.
+
+use crate::dynamics::{relax_gravity, loads::Loads, EquilibriumInfo, ExplicitSolver, Stage, State};
+use crate::error::{Error, ModelError};
+use crate::mesh::Mesh;
+use crate::model::Model;
+use crate::output::frames::{FrameWriter, Kinematics};
+use crate::output::history::{HistoryWriter, Monitor};
+use crate::scene::Scene;
+use serde::Serialize;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Options of a run that are not part of the scene.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Override the output directory.
+    pub out_dir: Option<PathBuf>,
+    /// Where gmsh meshes are cached. Default `build/mesh`.
+    pub mesh_cache: Option<PathBuf>,
+    /// Show a progress bar (only drawn when stderr is a terminal). Default false.
+    pub progress: bool,
+}
+
+/// Peak of a quantity and where it happened.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Peak {
+    pub value: f64,
+    pub t: f64,
+    pub node_tag: u64,
+}
+
+/// What a run reports (written as `summary.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    pub scene: String,
+    pub mesh: PathBuf,
+    pub nodes: usize,
+    pub elements: usize,
+    pub tets: usize,
+    pub hexes: usize,
+    pub hex_shapes: usize,
+    pub dt: f64,
+    pub dt_stable: f64,
+    pub critical_element: u64,
+    pub critical_group: String,
+    pub steps: usize,
+    pub duration: f64,
+    pub threads: usize,
+    pub equilibrium: Option<EquilibriumInfo>,
+    pub energy: crate::dynamics::Energy,
+    pub peak_displacement: Peak,
+    pub monitors: Vec<Monitor>,
+    pub frames: usize,
+    pub out_dir: PathBuf,
+    pub pvd: Option<PathBuf>,
+    pub histories: Vec<PathBuf>,
+    pub notes: Vec<String>,
+    /// Stage wall times [s].
+    pub timings: Vec<(String, f64)>,
+    pub wall_time: f64,
+}
+
+/// Produce the mesh of a scene (gmsh for a `.geo`, or the given `.msh`) and read it.
+pub fn load_mesh(scene: &Scene, opts: &RunOptions) -> Result<Mesh, Error> {
+    let path = match (&scene.geometry.geo, &scene.geometry.msh) {
+        (Some(geo), _) => {
+            let cache = opts.mesh_cache.clone().unwrap_or_else(|| PathBuf::from("build/mesh"));
+            crate::gmsh::mesh_geo(geo, &scene.geometry.set, &cache)?
+        }
+        (None, Some(msh)) => msh.clone(),
+        (None, None) => unreachable!("validated"),
+    };
+    Ok(Mesh::from_msh(path)?)
+}
+
+/// Snap monitored points to nodes (optionally of a group).
+pub fn snap_monitors(model: &Model, scene: &Scene) -> Result<Vec<Monitor>, Error> {
+    let mut out = Vec::new();
+    for m in &scene.output.monitor {
+        let candidates: Vec<usize> = match &m.group {
+            Some(g) => model.mesh.group_nodes(g)?,
+            None => (0..model.n_nodes()).filter(|&n| model.mass[n] > 0.0).collect(),
+        };
+        let d = |n: usize| {
+            let x = model.mesh.nodes[n];
+            ((x[0] - m.point[0]).powi(2) + (x[1] - m.point[1]).powi(2) + (x[2] - m.point[2]).powi(2)).sqrt()
+        };
+        let node = candidates
+            .iter()
+            .copied()
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)).then(a.cmp(&b)))
+            .ok_or_else(|| ModelError::Invalid(format!("monitor \"{}\": no node to snap to", m.name)))?;
+        out.push(Monitor {
+            name: m.name.clone(),
+            requested: m.point,
+            node,
+            node_tag: model.mesh.node_tags[node],
+            position: model.mesh.nodes[node],
+            snap_distance: d(node),
+        });
+    }
+    Ok(out)
+}
+
+/// Run a scene file end to end.
+pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
+    let t_all = Instant::now();
+    let mut timings = Vec::new();
+    let mut lap = |name: &str, t: &mut Instant| {
+        timings.push((name.to_string(), t.elapsed().as_secs_f64()));
+        *t = Instant::now();
+    };
+    let mut t = Instant::now();
+    let scene = Scene::load(scene_path)?;
+    if !scene.joints.is_empty() {
+        return Err(ModelError::Invalid(format!(
+            "scene {} declares joints; contact is not available in this build (see the contact issue)",
+            scene_path.display()
+        ))
+        .into());
+    }
+    let mesh = load_mesh(&scene, opts)?;
+    let mesh_path = mesh.source.clone();
+    lap("mesh", &mut t);
+    let model = Model::build(mesh, &scene)?;
+    let (loads, mut notes) = Loads::build(&model, &scene)?;
+    lap("model", &mut t);
+
+    // ---- time step
+    let dt_stable = model.stable_dt();
+    let dt = match scene.time.dt {
+        Some(dt) => {
+            if dt > dt_stable {
+                return Err(ModelError::UnstableStep { dt, limit: dt_stable, element: model.critical.tag, group: model.critical.group.clone() }.into());
+            }
+            dt
+        }
+        None => scene.time.courant.unwrap_or(0.9) * dt_stable,
+    };
+    let mut solver = ExplicitSolver::new(&model, dt, scene.time.energy_tolerance);
+    let mut state = State::at_rest(&model);
+
+    // ---- gravity equilibrium
+    let equilibrium = if loads.gravity.is_some() {
+        let eq = relax_gravity(&model, &loads, &mut solver, &mut state, None, scene.equilibrium.tolerance, scene.equilibrium.max_steps)?;
+        if !eq.converged && eq.residual > scene.equilibrium.max_residual {
+            return Err(ModelError::Invalid(format!(
+                "gravity equilibrium not reached in {} steps: residual {:.2e} > max_residual {:.1e}. Raise equilibrium.max_steps or check supports (a block without supports or contact falls freely).",
+                eq.steps, eq.residual, scene.equilibrium.max_residual
+            ))
+            .into());
+        }
+        if !eq.converged {
+            notes.push(format!("gravity equilibrium residual {:.2e} above tolerance {:.1e} (accepted below max_residual)", eq.residual, scene.equilibrium.tolerance));
+        }
+        state.step = 0;
+        state.t = 0.0;
+        Some(eq)
+    } else {
+        None
+    };
+    lap("equilibrium", &mut t);
+
+    // ---- outputs
+    let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
+    std::fs::create_dir_all(&out_dir).map_err(|e| crate::error::OutputError::write(&out_dir, e))?;
+    let monitors = snap_monitors(&model, &scene)?;
+    let mut history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
+    let mut frames = if scene.output.frames { Some(FrameWriter::create(&out_dir, scene.name(), &model)?) } else { None };
+    let n_steps = (scene.time.duration / dt).round() as usize;
+    let frame_stride = scene.output.frame_stride.unwrap_or_else(|| (n_steps / 100).max(1));
+    let hist_stride = scene.output.history_stride.max(1);
+
+    // ---- dynamic stage
+    solver.start_energy(&model, &mut state);
+    let bar = if opts.progress && std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(n_steps as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{prefix} [{bar:40}] {pos}/{len} steps, t = {msg} s, eta {eta}")
+                .unwrap()
+                .progress_chars("=> "),
+        );
+        b.set_prefix(scene.name().to_string());
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let mut peak = Peak::default();
+    let mut rows = vec![[0.0; 9]; monitors.len()];
+    for k in 0..n_steps {
+        solver.step(&model, &loads, &mut state, Stage::Dynamic, None)?;
+        // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt
+        let kin = Kinematics { t: state.t - dt, dt, u_prev: &solver.u_nm1, u: &state.u_prev, u_next: &state.u };
+        if k % hist_stride == 0 {
+            for (r, m) in rows.iter_mut().zip(&monitors) {
+                for c in 0..3 {
+                    let i = 3 * m.node + c;
+                    r[c] = kin.u[i];
+                    r[3 + c] = (kin.u_next[i] - kin.u_prev[i]) / (2.0 * dt);
+                    r[6 + c] = (kin.u_next[i] - 2.0 * kin.u[i] + kin.u_prev[i]) / (dt * dt);
+                }
+            }
+            history.row(kin.t, &rows)?;
+        }
+        if k % 10 == 0 || k + 1 == n_steps {
+            for n in 0..model.n_nodes() {
+                let m2 = kin.u[3 * n].powi(2) + kin.u[3 * n + 1].powi(2) + kin.u[3 * n + 2].powi(2);
+                if m2 > peak.value * peak.value {
+                    peak = Peak { value: m2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
+                }
+            }
+        }
+        if k % frame_stride == 0 || k + 1 == n_steps {
+            if let Some(f) = frames.as_mut() {
+                f.write(&model, &kin)?;
+            }
+            history.flush()?;
+        }
+        if k % 64 == 0 {
+            bar.set_position(k as u64);
+            bar.set_message(format!("{:.4}", kin.t));
+        }
+    }
+    bar.finish_and_clear();
+    history.flush()?;
+    lap("dynamic", &mut t);
+
+    let summary = RunSummary {
+        scene: scene.name().to_string(),
+        mesh: mesh_path,
+        nodes: model.n_nodes(),
+        elements: model.n_elements(),
+        tets: model.tets.nodes.len(),
+        hexes: model.hexes.nodes.len(),
+        hex_shapes: model.hexes.shapes.len(),
+        dt,
+        dt_stable,
+        critical_element: model.critical.tag,
+        critical_group: model.critical.group.clone(),
+        steps: n_steps,
+        duration: scene.time.duration,
+        threads: rayon::current_num_threads(),
+        equilibrium,
+        energy: state.energy.clone(),
+        peak_displacement: peak,
+        monitors,
+        frames: frames.as_ref().map(|f| f.series.len()).unwrap_or(0),
+        pvd: frames.as_ref().map(|f| f.series.path().to_path_buf()),
+        histories: history.paths(),
+        out_dir: out_dir.clone(),
+        notes,
+        timings,
+        wall_time: t_all.elapsed().as_secs_f64(),
+    };
+    let sp = out_dir.join("summary.json");
+    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("summary serialises"))
+        .map_err(|e| crate::error::OutputError::write(&sp, e))?;
+    Ok(summary)
+}
+
+impl RunSummary {
+    /// One screen of text for the end of a run.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        use std::fmt::Write as _;
+        let _ = writeln!(s, "scene {}: {} nodes, {} elements ({} tet4, {} hex8 in {} shapes)", self.scene, self.nodes, self.elements, self.tets, self.hexes, self.hex_shapes);
+        let _ = writeln!(s, "  mesh            {}", self.mesh.display());
+        let _ = writeln!(
+            s,
+            "  time step       dt = {:.4e} s ({:.0}% of the stable {:.4e} s; critical element {} in \"{}\")",
+            self.dt,
+            100.0 * self.dt / self.dt_stable,
+            self.dt_stable,
+            self.critical_element,
+            self.critical_group
+        );
+        let _ = writeln!(s, "  steps           {} over {} s on {} threads", self.steps, self.duration, self.threads);
+        if let Some(eq) = &self.equilibrium {
+            let _ = writeln!(s, "  gravity         equilibrium in {} steps, residual {:.2e}{}", eq.steps, eq.residual, if eq.converged { "" } else { " (NOT converged)" });
+        }
+        let _ = writeln!(s, "  energy          max balance error {:.2e} of the energy scale {:.3e} J", self.energy.max_error, self.energy.scale);
+        let _ = writeln!(s, "  peak |u|        {:.4e} m at t = {:.4} s, node {}", self.peak_displacement.value, self.peak_displacement.t, self.peak_displacement.node_tag);
+        for m in &self.monitors {
+            let _ = writeln!(s, "  monitor {:8} node {} ({:.3e} m from the requested point)", m.name, m.node_tag, m.snap_distance);
+        }
+        for n in &self.notes {
+            let _ = writeln!(s, "  note            {n}");
+        }
+        let t: Vec<String> = self.timings.iter().map(|(k, v)| format!("{k} {v:.2} s")).collect();
+        let _ = writeln!(s, "  wall time       {:.2} s ({})", self.wall_time, t.join(", "));
+        let _ = writeln!(s, "results in {}", self.out_dir.display());
+        if let Some(p) = &self.pvd {
+            let _ = writeln!(s, "  ParaView series {} ({} frames)", p.display(), self.frames);
+        }
+        for h in &self.histories {
+            let _ = writeln!(s, "  history         {}", h.display());
+        }
+        let _ = writeln!(s, "  summary         {}", self.out_dir.join("summary.json").display());
+        s
+    }
+}

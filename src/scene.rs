@@ -1,0 +1,452 @@
+//! Scene files (`pipelines/*.json`): serde types, loading and validation.
+//!
+//! Every field is documented in `docs/scenes.md` with its unit and default. Unknown keys are
+//! errors (`deny_unknown_fields`). Relative paths inside a scene are relative to the scene
+//! file's directory. Units: SI (m, kg, s, Pa, N); record amplitudes are in g.
+
+use crate::error::SceneError;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A whole scene.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name used for output files. Default: the scene file's stem.
+    #[serde(default)]
+    pub name: Option<String>,
+    pub geometry: Geometry,
+    /// Elastic materials per volume group.
+    pub materials: Vec<MaterialSpec>,
+    /// Fixed displacement components on groups (relative displacement 0).
+    #[serde(default)]
+    pub boundary: Vec<BoundarySpec>,
+    #[serde(default)]
+    pub loads: Loads,
+    #[serde(default)]
+    pub damping: Damping,
+    pub time: TimeSpec,
+    #[serde(default)]
+    pub equilibrium: EquilibriumSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// Joints (contact interfaces); see docs/scenes.md.
+    #[serde(default)]
+    pub joints: Vec<JointSceneSpec>,
+    /// Standard gravity used to convert records from g [m/s²]. Default 9.81.
+    #[serde(default = "default_g")]
+    pub g: f64,
+}
+
+fn default_g() -> f64 {
+    9.81
+}
+
+/// Where the mesh comes from: a `.geo` run through gmsh, or a ready `.msh`.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Geometry {
+    /// A Gmsh script; meshed with `gmsh -3`, numbers passed with `-setnumber`.
+    #[serde(default)]
+    pub geo: Option<PathBuf>,
+    /// `-setnumber NAME VALUE` parameters for the `.geo`.
+    #[serde(default)]
+    pub set: BTreeMap<String, f64>,
+    /// A ready MSH 4.1 mesh (instead of `geo`).
+    #[serde(default)]
+    pub msh: Option<PathBuf>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Physical volume group, e.g. `block:wedge`.
+    pub group: String,
+    /// Young's modulus [Pa].
+    #[serde(rename = "E")]
+    pub e: f64,
+    /// Poisson's ratio [-], 0 ≤ ν < 0.5.
+    pub nu: f64,
+    /// Density [kg/m³]. 0 makes the group massless (foundation); it then needs no time step.
+    pub rho: f64,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundarySpec {
+    /// Physical group (any dimension) whose nodes are fixed.
+    pub group: String,
+    /// Components fixed: any of "x", "y", "z". Default all three.
+    #[serde(default = "all_components")]
+    pub fix: Vec<String>,
+}
+
+fn all_components() -> Vec<String> {
+    vec!["x".into(), "y".into(), "z".into()]
+}
+
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Loads {
+    /// Gravity (body force ρ g), brought to equilibrium before the record starts.
+    #[serde(default)]
+    pub gravity: Option<Gravity>,
+    /// Uniform base acceleration, up to three records.
+    #[serde(default)]
+    pub base: Vec<BaseRecord>,
+    /// Surface tractions on face groups (for tests and static loads).
+    #[serde(default)]
+    pub traction: Vec<TractionSpec>,
+    /// Nodal forces at the node nearest to a point.
+    #[serde(default)]
+    pub nodal: Vec<NodalForceSpec>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gravity {
+    /// Acceleration of gravity [m/s²]. Default 9.81.
+    #[serde(default = "default_g")]
+    pub g: f64,
+    /// Unit direction. Default [0, 0, -1] (z up).
+    #[serde(default = "down")]
+    pub direction: [f64; 3],
+}
+
+fn down() -> [f64; 3] {
+    [0.0, 0.0, -1.0]
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaseRecord {
+    /// Two-column text (t [s], a [g], `#` comments) or a PEER `.AT2` file.
+    pub record: PathBuf,
+    /// Direction of the ground acceleration (normalised on load).
+    pub direction: [f64; 3],
+    /// Multiplier on the record. Default 1. Exclusive with `pga`.
+    #[serde(default)]
+    pub scale: Option<f64>,
+    /// Target peak ground acceleration [g]: the record is scaled so that max |a| = pga.
+    #[serde(default)]
+    pub pga: Option<f64>,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TractionSpec {
+    /// Face group (tri3/quad4) carrying the traction.
+    pub group: String,
+    /// Traction vector [Pa] (force per unit area, global axes).
+    pub traction: [f64; 3],
+    /// Time history: linear ramp from 0 over `ramp` seconds, then constant. Default 0 (step load).
+    #[serde(default)]
+    pub ramp: f64,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodalForceSpec {
+    /// Point [m]; the force acts on the nearest node (snap distance reported).
+    pub point: [f64; 3],
+    /// Force [N].
+    pub force: [f64; 3],
+    /// Ramp duration [s]. Default 0 (step).
+    #[serde(default)]
+    pub ramp: f64,
+}
+
+/// Rayleigh damping C = αM + βK, given directly or as a damping ratio at two frequencies.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Damping {
+    /// Mass-proportional coefficient α [1/s]. Default 0.
+    #[serde(default)]
+    pub alpha: Option<f64>,
+    /// Stiffness-proportional coefficient β [s]. Default 0.
+    #[serde(default)]
+    pub beta: Option<f64>,
+    /// Damping ratio ξ [-] reached at `f1` and `f2` (exclusive with alpha/beta).
+    #[serde(default)]
+    pub ratio: Option<f64>,
+    /// First frequency [Hz] for `ratio`.
+    #[serde(default)]
+    pub f1: Option<f64>,
+    /// Second frequency [Hz] for `ratio`.
+    #[serde(default)]
+    pub f2: Option<f64>,
+}
+
+impl Damping {
+    /// (α, β) from the given form. Two-frequency form: α = 2ξ ω1ω2/(ω1+ω2), β = 2ξ/(ω1+ω2).
+    pub fn coefficients(&self) -> Result<(f64, f64), String> {
+        match (self.ratio, self.alpha, self.beta) {
+            (Some(xi), None, None) => {
+                let (f1, f2) = match (self.f1, self.f2) {
+                    (Some(a), Some(b)) if a > 0.0 && b > 0.0 && a != b => (a, b),
+                    _ => return Err("damping: `ratio` needs two distinct positive frequencies `f1` and `f2` [Hz]".into()),
+                };
+                if !(0.0..1.0).contains(&xi) {
+                    return Err(format!("damping: ratio {xi} must be in [0, 1)"));
+                }
+                let (w1, w2) = (2.0 * std::f64::consts::PI * f1, 2.0 * std::f64::consts::PI * f2);
+                Ok((2.0 * xi * w1 * w2 / (w1 + w2), 2.0 * xi / (w1 + w2)))
+            }
+            (None, a, b) => {
+                let (a, b) = (a.unwrap_or(0.0), b.unwrap_or(0.0));
+                if a < 0.0 || b < 0.0 || !a.is_finite() || !b.is_finite() {
+                    return Err(format!("damping: alpha = {a} and beta = {b} must be finite and ≥ 0"));
+                }
+                Ok((a, b))
+            }
+            _ => Err("damping: give either `ratio` with `f1`, `f2`, or `alpha`/`beta`, not both".into()),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// Duration of the dynamic stage [s].
+    pub duration: f64,
+    /// Time step [s]. Must not exceed the stability limit (the run stops with the limit quoted).
+    #[serde(default)]
+    pub dt: Option<f64>,
+    /// Fraction of the stable step used when `dt` is not given. Default 0.9.
+    #[serde(default)]
+    pub courant: Option<f64>,
+    /// Energy-balance tolerance (relative to the energy scale) above which the run stops. Default 0.05.
+    #[serde(default = "default_energy_tol")]
+    pub energy_tolerance: f64,
+}
+
+fn default_energy_tol() -> f64 {
+    0.05
+}
+
+/// Gravity equilibrium before the dynamic stage (dynamic relaxation with kinetic damping).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct EquilibriumSpec {
+    /// Relative residual ‖F − K u‖/‖F‖ at which relaxation stops. Default 1e-6.
+    #[serde(default = "default_eq_tol")]
+    pub tolerance: f64,
+    /// Largest residual accepted when `max_steps` is reached (else the run stops). Default 1e-3.
+    #[serde(default = "default_eq_max_res")]
+    pub max_residual: f64,
+    /// Step budget of the relaxation. Default 200000.
+    #[serde(default = "default_eq_steps")]
+    pub max_steps: usize,
+}
+
+fn default_eq_tol() -> f64 {
+    1e-6
+}
+fn default_eq_max_res() -> f64 {
+    1e-3
+}
+fn default_eq_steps() -> usize {
+    200_000
+}
+
+impl Default for EquilibriumSpec {
+    fn default() -> Self {
+        EquilibriumSpec { tolerance: default_eq_tol(), max_residual: default_eq_max_res(), max_steps: default_eq_steps() }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Output directory. Default `out/<scene name>`.
+    #[serde(default)]
+    pub dir: Option<PathBuf>,
+    /// A VTU frame every `frame_stride` steps. Default: about 100 frames over the run.
+    #[serde(default)]
+    pub frame_stride: Option<usize>,
+    /// History rows every `history_stride` steps. Default 1.
+    #[serde(default = "one")]
+    pub history_stride: usize,
+    /// Monitored points, snapped to the nearest node (snap distance reported).
+    #[serde(default)]
+    pub monitor: Vec<MonitorSpec>,
+    /// Write VTU frames at all. Default true (studies switch it off for sweeps).
+    #[serde(default = "yes")]
+    pub frames: bool,
+}
+
+fn one() -> usize {
+    1
+}
+fn yes() -> bool {
+    true
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { dir: None, frame_stride: None, history_stride: 1, monitor: vec![], frames: true }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorSpec {
+    pub name: String,
+    /// Point [m].
+    pub point: [f64; 3],
+    /// Restrict the snap to nodes of this group (e.g. a block). Default: any node.
+    #[serde(default)]
+    pub group: Option<String>,
+}
+
+/// A joint as written in a scene (tagging and contact options).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSceneSpec {
+    pub name: String,
+    /// Face group of the master side, or of one side when `auto`.
+    pub master: String,
+    /// Face group of the slave side.
+    pub slave: String,
+    /// Let the tagger choose: the finer side becomes the slave. Default false.
+    #[serde(default)]
+    pub auto: bool,
+    /// Largest distance [m] between the two sides accepted by the tagger. Default 1e-6 × model size.
+    #[serde(default)]
+    pub tolerance: Option<f64>,
+    /// Contact method: "nts" (default) or "ntn" or "penalty".
+    #[serde(default)]
+    pub method: Option<String>,
+    /// Candidate layer: 1 (default) or 2.
+    #[serde(default)]
+    pub layer: Option<u8>,
+    /// When a projection leaves the candidate set: "widen" (default) or "report".
+    #[serde(default)]
+    pub on_exit: Option<String>,
+    /// Friction coefficient μ [-]. Default 0.6.
+    #[serde(default)]
+    pub mu: Option<f64>,
+    /// Friction angle [deg] (instead of mu).
+    #[serde(default)]
+    pub phi: Option<f64>,
+    /// Cohesion [Pa]. Default 0.
+    #[serde(default)]
+    pub cohesion: Option<f64>,
+    /// Tensile strength [Pa] while intact. Default 0.
+    #[serde(default)]
+    pub tensile_strength: Option<f64>,
+    /// Keep cohesion after slip/opening. Default false.
+    #[serde(default)]
+    pub keep_cohesion: Option<bool>,
+    /// Tied (bonded, never opens or slides). Default false.
+    #[serde(default)]
+    pub tied: Option<bool>,
+    /// Penalty stiffness per unit area [Pa/m] for method "penalty".
+    #[serde(default)]
+    pub penalty_stiffness: Option<f64>,
+}
+
+impl Scene {
+    /// Read and validate a scene file; relative paths are resolved against its directory.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+        let mut scene: Scene = serde_json::from_str(&text).map_err(|e| SceneError::Parse {
+            path: path.to_path_buf(),
+            message: format!("{e} (see docs/scenes.md for the fields)"),
+        })?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let resolve = |p: &mut PathBuf| {
+            if p.is_relative() {
+                *p = base.join(&*p);
+            }
+        };
+        if let Some(g) = scene.geometry.geo.as_mut() {
+            resolve(g);
+        }
+        if let Some(m) = scene.geometry.msh.as_mut() {
+            resolve(m);
+        }
+        for b in &mut scene.loads.base {
+            resolve(&mut b.record);
+        }
+        if scene.name.is_none() {
+            scene.name = Some(path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string());
+        }
+        scene.validate().map_err(|message| SceneError::Invalid { path: path.to_path_buf(), message })?;
+        Ok(scene)
+    }
+
+    /// The scene's name (set by `load`).
+    pub fn name(&self) -> &str {
+        self.name.as_deref().unwrap_or("scene")
+    }
+
+    /// Output directory: `output.dir` or `out/<name>`.
+    pub fn output_dir(&self) -> PathBuf {
+        self.output.dir.clone().unwrap_or_else(|| PathBuf::from("out").join(self.name()))
+    }
+
+    /// Checks that need no mesh (group names are checked against the mesh when the model is built).
+    pub fn validate(&self) -> Result<(), String> {
+        match (&self.geometry.geo, &self.geometry.msh) {
+            (Some(_), Some(_)) => return Err("geometry: give either `geo` or `msh`, not both".into()),
+            (None, None) => return Err("geometry: give `geo` (a Gmsh script) or `msh` (a mesh file)".into()),
+            _ => {}
+        }
+        if self.materials.is_empty() {
+            return Err("materials: at least one material group is needed".into());
+        }
+        for m in &self.materials {
+            if !(m.e > 0.0 && m.e.is_finite()) {
+                return Err(format!("material \"{}\": E = {} must be positive [Pa]", m.group, m.e));
+            }
+            if !(0.0..0.5).contains(&m.nu) {
+                return Err(format!("material \"{}\": nu = {} must be in [0, 0.5)", m.group, m.nu));
+            }
+            if !(m.rho >= 0.0 && m.rho.is_finite()) {
+                return Err(format!("material \"{}\": rho = {} must be ≥ 0 [kg/m³]", m.group, m.rho));
+            }
+        }
+        for b in &self.boundary {
+            for c in &b.fix {
+                if !matches!(c.as_str(), "x" | "y" | "z") {
+                    return Err(format!("boundary \"{}\": component \"{c}\" must be \"x\", \"y\" or \"z\"", b.group));
+                }
+            }
+        }
+        if self.loads.base.len() > 3 {
+            return Err(format!("loads.base: {} records given, at most 3", self.loads.base.len()));
+        }
+        for b in &self.loads.base {
+            if b.scale.is_some() && b.pga.is_some() {
+                return Err(format!("loads.base {}: give `scale` or `pga`, not both", b.record.display()));
+            }
+            let n = (b.direction[0].powi(2) + b.direction[1].powi(2) + b.direction[2].powi(2)).sqrt();
+            if !(n > 0.0 && n.is_finite()) {
+                return Err(format!("loads.base {}: direction must be a non-zero vector", b.record.display()));
+            }
+        }
+        if !(self.time.duration >= 0.0 && self.time.duration.is_finite()) {
+            return Err(format!("time.duration = {} must be ≥ 0 [s]", self.time.duration));
+        }
+        if let Some(dt) = self.time.dt {
+            if !(dt > 0.0 && dt.is_finite()) {
+                return Err(format!("time.dt = {dt} must be positive [s]"));
+            }
+        }
+        if let Some(c) = self.time.courant {
+            if !(c > 0.0 && c <= 1.0) {
+                return Err(format!("time.courant = {c} must be in (0, 1]"));
+            }
+        }
+        if self.time.dt.is_some() && self.time.courant.is_some() {
+            return Err("time: give `dt` or `courant`, not both".into());
+        }
+        self.damping.coefficients()?;
+        if !(self.g > 0.0) {
+            return Err(format!("g = {} must be positive [m/s²]", self.g));
+        }
+        Ok(())
+    }
+}
