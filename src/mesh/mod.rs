@@ -12,6 +12,7 @@
 
 pub mod cell;
 pub mod msh;
+pub mod structured;
 pub mod topology;
 
 pub use cell::{Cell, CellKind};

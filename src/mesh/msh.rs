@@ -153,3 +153,69 @@ fn physical_names(bytes: &[u8]) -> Result<HashMap<(usize, i32), String>, String>
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
 }
+
+/// Write `mesh` as ASCII MSH 4.1 (one entity per physical group; a cell that belongs to
+/// several groups is written once per group, under new element tags). Used by tests and
+/// fixtures built in memory; gmsh and mshio read the result.
+pub fn write_msh41(mesh: &Mesh, path: &std::path::Path) -> std::io::Result<()> {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "$MeshFormat\n4.1 0 8\n$EndMeshFormat");
+    let _ = writeln!(s, "$PhysicalNames\n{}", mesh.groups.len());
+    for g in &mesh.groups {
+        let _ = writeln!(s, "{} {} \"{}\"", g.dim, g.tag, g.name);
+    }
+    let _ = writeln!(s, "$EndPhysicalNames");
+    // entities: group k → entity tag k+1 of its dimension
+    let count = |d: usize| mesh.groups.iter().filter(|g| g.dim == d).count();
+    let _ = writeln!(s, "$Entities\n0 {} {} {}", count(1), count(2), count(3));
+    let (lo, hi) = mesh.nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(mut lo, mut hi), x| {
+        for i in 0..3 {
+            lo[i] = lo[i].min(x[i]);
+            hi[i] = hi[i].max(x[i]);
+        }
+        (lo, hi)
+    });
+    for d in 1..=3 {
+        for (k, g) in mesh.groups.iter().enumerate().filter(|(_, g)| g.dim == d) {
+            let _ = writeln!(s, "{} {} {} {} {} {} {} 1 {} 0", k + 1, lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], g.tag);
+        }
+    }
+    let _ = writeln!(s, "$EndEntities");
+    let n = mesh.nodes.len();
+    let _ = writeln!(s, "$Nodes\n1 {n} 1 {n}\n3 0 0 {n}");
+    for i in 0..n {
+        let _ = writeln!(s, "{}", i + 1);
+    }
+    for x in &mesh.nodes {
+        let _ = writeln!(s, "{:.17e} {:.17e} {:.17e}", x[0], x[1], x[2]);
+    }
+    let _ = writeln!(s, "$EndNodes");
+    let total: usize = mesh.groups.iter().filter(|g| g.dim >= 1).map(|g| g.cells.len()).sum();
+    let blocks: Vec<(usize, &Group)> = mesh.groups.iter().enumerate().filter(|(_, g)| !g.cells.is_empty()).collect();
+    let _ = writeln!(s, "$Elements\n{} {} 1 {}", blocks.len(), total, total);
+    let mut etag = 0;
+    for (k, g) in blocks {
+        let kind = mesh.cells[g.cells[0]].kind;
+        let ty = match kind {
+            CellKind::Tri3 => 2,
+            CellKind::Quad4 => 3,
+            CellKind::Tet4 => 4,
+            CellKind::Hex8 => 5,
+        };
+        if g.cells.iter().any(|&c| mesh.cells[c].kind != kind) {
+            return Err(std::io::Error::other(format!("group {} mixes cell kinds; write_msh41 needs one kind per group", g.name)));
+        }
+        let _ = writeln!(s, "{} {} {} {}", g.dim, k + 1, ty, g.cells.len());
+        for &c in &g.cells {
+            etag += 1;
+            let _ = write!(s, "{etag}");
+            for &nd in mesh.cells[c].nodes() {
+                let _ = write!(s, " {}", nd + 1);
+            }
+            let _ = writeln!(s);
+        }
+    }
+    let _ = writeln!(s, "$EndElements");
+    std::fs::write(path, s)
+}

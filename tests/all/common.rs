@@ -14,3 +14,32 @@ pub fn scratch(name: &str) -> PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+use jointquake::dynamics::{loads::Loads, ExplicitSolver, Stage, State};
+use jointquake::model::Model;
+use jointquake::scene::Scene;
+
+/// A scene from inline JSON (fields as in pipelines/*.json).
+pub fn scene(v: serde_json::Value) -> Scene {
+    serde_json::from_value(v).expect("test scene parses")
+}
+
+/// Mean of component `c` of u over `nodes`.
+pub fn mean_u(u: &[f64], nodes: &[usize], c: usize) -> f64 {
+    nodes.iter().map(|&n| u[3 * n + c]).sum::<f64>() / nodes.len() as f64
+}
+
+/// Run the dynamic stage from rest for `steps` steps at `courant` × the stable step, calling
+/// `observe(t, u)` after every step with u = u[n+1] at t[n+1].
+pub fn simulate(model: &Model, scene: &Scene, courant: f64, steps: usize, mut observe: impl FnMut(f64, &[f64])) -> (f64, State) {
+    let (loads, _) = Loads::build(model, scene).expect("loads");
+    let dt = courant * model.stable_dt();
+    let mut solver = ExplicitSolver::new(model, dt, scene.time.energy_tolerance);
+    let mut state = State::at_rest(model);
+    solver.start_energy(model, &mut state);
+    for _ in 0..steps {
+        solver.step(model, &loads, &mut state, Stage::Dynamic, None).expect("step");
+        observe(state.t, &state.u);
+    }
+    (dt, state)
+}
