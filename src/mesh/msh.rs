@@ -1,7 +1,9 @@
 //! Reading MSH 4.1 with `mshio`, plus the `$PhysicalNames` section it skips.
 //!
-//! Node tags: mshio keeps per-block tag maps only when the file's tags are sparse;
-//! otherwise tags are the contiguous range min..=max in file order (as Gmsh writes them).
+//! Node tags: mshio keeps per-block tag maps only when the file's tags are sparse
+//! (max - min + 1 > count). When they are dense it drops them, yet dense tags need not
+//! appear in file order (another writer may list 3 1 2), so in that case the tags are
+//! read here directly from the `$Nodes` section ([`node_tags_in_file_order`]).
 
 use super::{Cell, CellKind, Group, Mesh};
 use crate::error::MeshError;
@@ -33,7 +35,17 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
     let nodes_sec = msh.data.nodes.as_ref().ok_or_else(|| malformed("no $Nodes section".into()))?;
     let mut nodes = Vec::with_capacity(nodes_sec.num_nodes as usize);
     let mut node_tags = Vec::with_capacity(nodes_sec.num_nodes as usize);
-    let mut next_tag = nodes_sec.min_node_tag;
+    let file_tags = if nodes_sec.node_blocks.iter().any(|b| b.node_tags.is_none()) {
+        let tags = node_tags_in_file_order(bytes, &msh.header).map_err(malformed)?;
+        let n: usize = nodes_sec.node_blocks.iter().map(|b| b.nodes.len()).sum();
+        if tags.len() != n {
+            return Err(malformed(format!("$Nodes lists {} node tags for {n} nodes", tags.len())));
+        }
+        tags
+    } else {
+        Vec::new()
+    };
+    let mut next = 0usize; // position in file_tags
     for block in &nodes_sec.node_blocks {
         let mut tags = vec![0u64; block.nodes.len()];
         match &block.node_tags {
@@ -43,12 +55,10 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
                 }
             }
             None => {
-                for t in tags.iter_mut() {
-                    *t = next_tag;
-                    next_tag += 1;
-                }
+                tags.copy_from_slice(&file_tags[next..next + block.nodes.len()]);
             }
         }
+        next += block.nodes.len();
         for (n, t) in block.nodes.iter().zip(tags) {
             if !(n.x.is_finite() && n.y.is_finite() && n.z.is_finite()) {
                 return Err(MeshError::NonFiniteNode { path: path.clone(), node: t });
@@ -128,6 +138,70 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
         })
         .collect();
     Ok(Mesh { source: path, nodes, node_tags, cells, groups })
+}
+
+/// Node tags of the `$Nodes` section in file order (ASCII or binary MSH 4.1; mshio has
+/// already validated the section's structure, this only walks it again for the tags).
+fn node_tags_in_file_order(bytes: &[u8], header: &mshio::MshHeader) -> Result<Vec<u64>, String> {
+    const ERR: &str = "$Nodes section ends early";
+    let start = find(bytes, b"$Nodes").ok_or("no $Nodes section")? + b"$Nodes".len();
+    let body = &bytes[start..];
+    let mut tags = Vec::new();
+    if header.file_type == 0 {
+        let end = find(body, b"$EndNodes").ok_or("$Nodes has no $EndNodes")?;
+        let text = std::str::from_utf8(&body[..end]).map_err(|_| "$Nodes is not text in an ASCII file")?;
+        let mut tok = text.split_ascii_whitespace();
+        fn num<'a>(tok: &mut impl Iterator<Item = &'a str>) -> Result<u64, String> {
+            let t = tok.next().ok_or(ERR)?;
+            t.parse::<u64>().map_err(|e| format!("$Nodes: `{t}`: {e}"))
+        }
+        let blocks = num(&mut tok)?;
+        for _ in 0..3 {
+            num(&mut tok)?; // numNodes minNodeTag maxNodeTag
+        }
+        for _ in 0..blocks {
+            let (_dim, _entity, _parametric, n) = (num(&mut tok)?, num(&mut tok)?, num(&mut tok)?, num(&mut tok)?);
+            for _ in 0..n {
+                tags.push(num(&mut tok)?);
+            }
+            for _ in 0..3 * n {
+                tok.next().ok_or(ERR)?; // x y z (parametric nodes are rejected by mshio)
+            }
+        }
+    } else {
+        // binary: "4.1 1 8\n" then a binary int 1 that tells the byte order
+        let fmt = find(bytes, b"$MeshFormat").ok_or("no $MeshFormat")?;
+        let nl = fmt + bytes[fmt..].iter().position(|&b| b == b'\n').ok_or(ERR)? + 1;
+        let nl = nl + bytes[nl..].iter().position(|&b| b == b'\n').ok_or(ERR)? + 1;
+        let one = bytes.get(nl..nl + header.int_size).ok_or(ERR)?;
+        let little = one.first() == Some(&1);
+        let (st, is, fs) = (header.size_t_size, header.int_size, header.float_size);
+        let mut pos = 1usize; // skip the newline after "$Nodes"
+        let mut read = |size: usize| -> Result<u64, String> {
+            let b = body.get(pos..pos + size).ok_or(ERR)?;
+            pos += size;
+            let mut v = 0u64;
+            for k in 0..size.min(8) {
+                let byte = if little { b[k] } else { b[size - 1 - k] };
+                v |= (byte as u64) << (8 * k);
+            }
+            Ok(v)
+        };
+        let blocks = read(st)?;
+        for _ in 0..3 {
+            read(st)?;
+        }
+        for _ in 0..blocks {
+            let (_dim, _entity, _parametric, n) = (read(is)?, read(is)?, read(is)?, read(st)?);
+            for _ in 0..n {
+                tags.push(read(st)?);
+            }
+            for _ in 0..3 * n {
+                read(fs)?;
+            }
+        }
+    }
+    Ok(tags)
 }
 
 /// Parse the `$PhysicalNames` section (text even in binary files): `dim tag "name"` per line.
