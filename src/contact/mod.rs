@@ -38,4 +38,5 @@
 //! the order of the candidates; a law response closes the trial gap exactly in compression and
 //! never exceeds the Mohr-Coulomb limit in shear.
 
+pub mod law;
 pub mod query;
