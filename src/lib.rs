@@ -22,6 +22,7 @@
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages.
 
+pub mod contact;
 pub mod dynamics;
 pub mod error;
 pub mod gmsh;

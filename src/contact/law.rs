@@ -1,0 +1,391 @@
+//! The dynamic contact force of one pair in its local frame (design.md §5): Mohr-Coulomb
+//! friction with cohesion, tensile strength and tied joints.
+//!
+//! Sign conventions are those of [`crate::contact`]: the force on the slave node is
+//! `R = −r_n n + r_t[0] t1 + r_t[1] t2`, `r_n > 0` compression. With the pair compliance
+//! `k = dt² w` (m/N) the pair's own force changes its relative displacement by `k R`, so
+//!
+//! ```text
+//! g[n+1]    = g̃ + k r_n          (closing:  r_n = −g̃ / k  gives g[n+1] = 0)
+//! Δd_t[n+1] = Δd̃_t + k r_t       (sticking: r_t = −Δd̃_t / k gives Δd_t = 0)
+//! ```
+//!
+//! where `g̃` is the trial gap and `Δd̃_t` the trial tangential relative displacement increment
+//! over the step, both from the contact-free prediction.
+//!
+//! Decision, in order:
+//! 1. `tied`: always bonded: `r_n = −g̃/k` (either sign), `r_t = −Δd̃_t/k`, no limit.
+//! 2. A pair is *bonded* when its bond is intact and the law has a tensile strength. Not bonded
+//!    and `g̃ ≥ 0`: **open**, `R = 0`.
+//! 3. Otherwise `r_n = −g̃/k`. Tension (`r_n < 0`, bonded pairs only) beyond `σ_t A`: the bond
+//!    breaks and the pair opens, `R = 0`.
+//! 4. Trial `r_t = −Δd̃_t/k`, limit `τ = μ r_n + c A` (`c A` only while intact), clamped at 0.
+//!    `|r_t| ≤ τ`: **stick** (state `Bonded` for a bonded pair). Else **slip**: `r_t` scaled back
+//!    to `τ` along the trial direction (opposite to the trial slip).
+//!
+//! The bond (cohesion and tensile strength) is lost on the first slip or opening (`g̃ > 0` while
+//! not bonded), unless `keep_cohesion`; a tensile rupture (step 3) always ends it, otherwise
+//! the pair could never open. When a slip ends the bond of a pair in tension, the pair opens in
+//! that same step (the response is that of the pair with its new history).
+//!
+//! Non-finite inputs propagate into the force (the solver reports non-finite values).
+
+use nalgebra::{Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// The strength of a joint, per pair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointLaw {
+    /// Friction coefficient μ = tan φ (dimensionless, ≥ 0). No default: every joint must state it.
+    pub mu: f64,
+    /// Cohesion c (Pa, ≥ 0), multiplied by the slave node's tributary area. Default 0: a clean
+    /// rock joint; cohesion is a site-specific measured value.
+    #[serde(default)]
+    pub cohesion: f64,
+    /// Tensile strength σ_t (Pa, ≥ 0; 0 = the joint carries no tension). Default 0: rock joints
+    /// and dam lift joints are assumed cracked, the conservative choice.
+    #[serde(default)]
+    pub tensile_strength: f64,
+    /// Keep cohesion (and tensile strength) after a pair slips or opens. Default false: the
+    /// bond is brittle and lost at the first slip or opening (design §5, as in the paper).
+    #[serde(default)]
+    pub keep_cohesion: bool,
+    /// Tied joint: the two sides are glued (stick always, no opening, no strength limit).
+    /// Default false. Used for non-conforming glued blocks (dam on foundation).
+    #[serde(default)]
+    pub tied: bool,
+}
+
+impl JointLaw {
+    /// Pure Coulomb friction μ: no cohesion, no tension, brittle defaults.
+    pub fn coulomb(mu: f64) -> Self {
+        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false }
+    }
+
+    /// A glued (tied) interface.
+    pub fn tied() -> Self {
+        JointLaw { tied: true, ..JointLaw::coulomb(0.0) }
+    }
+
+    /// Check that every parameter is finite and non-negative; the error names the field.
+    pub fn validate(&self) -> Result<(), JointLawError> {
+        for (field, value) in
+            [("mu", self.mu), ("cohesion", self.cohesion), ("tensile_strength", self.tensile_strength)]
+        {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(JointLawError { field, value });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// An invalid joint-law parameter.
+#[derive(Clone, Debug, PartialEq, Error)]
+#[error(
+    "joint law: `{field}` = {value} must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa)"
+)]
+pub struct JointLawError {
+    pub field: &'static str,
+    pub value: f64,
+}
+
+/// The state of a pair after a step.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PairState {
+    /// Gap open, no force.
+    Open,
+    /// In contact, no relative tangential motion.
+    Stick,
+    /// In contact, sliding at the Mohr-Coulomb limit.
+    Slip,
+    /// Bonded (intact tensile bond or tied): carries tension, sticks.
+    Bonded,
+}
+
+impl PairState {
+    /// Numeric code written to VTU files: open 0, stick 1, slip 2, bonded 3.
+    pub fn code(self) -> u8 {
+        match self {
+            PairState::Open => 0,
+            PairState::Stick => 1,
+            PairState::Slip => 2,
+            PairState::Bonded => 3,
+        }
+    }
+}
+
+/// What a pair remembers from step to step.
+#[derive(Copy, Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PairHistory {
+    /// The bond (cohesion, tensile strength) is intact: not yet lost by slip, opening or rupture.
+    pub intact: bool,
+    /// Accumulated slip path length (m): the sum of `|Δd_t|` over the steps in state `Slip`.
+    pub slip: f64,
+}
+
+impl Default for PairHistory {
+    /// A fresh pair: bond intact, no slip.
+    fn default() -> Self {
+        PairHistory { intact: true, slip: 0.0 }
+    }
+}
+
+/// The force of one pair and its new history.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct PairResponse {
+    /// Normal force magnitude (N): `> 0` compression, `< 0` tension (bonded pairs only).
+    pub r_n: f64,
+    /// Tangential force on the slave node in `(t1, t2)` (N).
+    pub r_t: Vector2<f64>,
+    pub state: PairState,
+    /// History to store for the next step.
+    pub hist: PairHistory,
+    /// Tangential relative displacement increment of the step after the force is applied
+    /// (m, `(t1, t2)`): zero in stick, along the trial direction in slip.
+    pub slip_increment: Vector2<f64>,
+}
+
+impl PairResponse {
+    fn open(hist: PairHistory, dt_trial: Vector2<f64>) -> Self {
+        PairResponse { r_n: 0.0, r_t: Vector2::zeros(), state: PairState::Open, hist, slip_increment: dt_trial }
+    }
+
+    /// The force on the slave node in global coordinates, `−r_n n + r_t[0] t1 + r_t[1] t2` (N).
+    /// The master nodes receive `−N_I` times it.
+    pub fn force_on_slave(&self, n: &Vector3<f64>, t1: &Vector3<f64>, t2: &Vector3<f64>) -> Vector3<f64> {
+        -n * self.r_n + t1 * self.r_t.x + t2 * self.r_t.y
+    }
+}
+
+/// The dynamic contact force of one pair (see the module doc for the decision order).
+///
+/// - `g_trial`: trial gap `g̃` (m) from the contact-free prediction, positive open.
+/// - `dt_trial`: trial relative tangential displacement increment over the step `Δd̃_t` (m), `(t1, t2)`.
+/// - `dt2w`: `dt² w` (m/N), must be > 0 (positive masses).
+/// - `area`: the slave node's tributary area `A_s` (m²).
+pub fn pair_force(
+    law: &JointLaw,
+    hist: &PairHistory,
+    g_trial: f64,
+    dt_trial: Vector2<f64>,
+    dt2w: f64,
+    area: f64,
+) -> PairResponse {
+    debug_assert!(dt2w > 0.0, "dt² w must be positive, got {dt2w}");
+    let k = dt2w;
+    if law.tied {
+        return PairResponse {
+            r_n: -g_trial / k,
+            r_t: -dt_trial / k,
+            state: PairState::Bonded,
+            hist: *hist,
+            slip_increment: Vector2::zeros(),
+        };
+    }
+    let bonded = hist.intact && law.tensile_strength > 0.0;
+    if g_trial >= 0.0 && !bonded {
+        let opened = g_trial > 0.0;
+        let intact = hist.intact && (law.keep_cohesion || !opened);
+        return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
+    }
+    let r_n = -g_trial / k;
+    if r_n < -law.tensile_strength * area {
+        // Tensile rupture (only reachable by a bonded pair): the bond is gone, the pair opens.
+        return PairResponse::open(PairHistory { intact: false, ..*hist }, dt_trial);
+    }
+    let r_trial = -dt_trial / k;
+    let cohesion = if hist.intact { law.cohesion * area } else { 0.0 };
+    let limit = (law.mu * r_n + cohesion).max(0.0);
+    let r_trial_norm = r_trial.norm();
+    if r_trial_norm <= limit {
+        let state = if bonded { PairState::Bonded } else { PairState::Stick };
+        return PairResponse { r_n, r_t: r_trial, state, hist: *hist, slip_increment: Vector2::zeros() };
+    }
+    // Slip: back to the limit along the trial direction.
+    let intact = hist.intact && law.keep_cohesion;
+    if hist.intact && !intact && r_n < 0.0 {
+        // The slip broke the bond of a pair in tension: with its new history it is open.
+        return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
+    }
+    let r_t = r_trial * (limit / r_trial_norm);
+    let slip_increment = dt_trial + r_t * k;
+    PairResponse {
+        r_n,
+        r_t,
+        state: PairState::Slip,
+        hist: PairHistory { intact, slip: hist.slip + slip_increment.norm() },
+        slip_increment,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // A pair with dt = 1e-4 s, m_s = 100 kg and one master node of 300 kg (N = 1):
+    // w = 1/100 + 1/300, k = dt² w.
+    const DT2W: f64 = 1e-8 * (1.0 / 100.0 + 1.0 / 300.0);
+    const AREA: f64 = 0.25;
+
+    fn law(mu: f64, c: f64, st: f64) -> JointLaw {
+        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false }
+    }
+
+    #[test]
+    fn open_pair_has_no_force() {
+        let r = pair_force(&law(0.6, 0.0, 0.0), &PairHistory::default(), 1e-6, Vector2::new(1e-5, 0.0), DT2W, AREA);
+        assert_eq!(r.state, PairState::Open);
+        assert_eq!((r.r_n, r.r_t), (0.0, Vector2::zeros()));
+        assert_eq!(r.state.code(), 0);
+    }
+
+    #[test]
+    fn closing_force_closes_the_gap_exactly() {
+        // Reference: g[n+1] = g̃ + k r_n = 0 (design §5), to round-off.
+        let g = -3e-7;
+        let r = pair_force(&law(0.6, 0.0, 0.0), &PairHistory::default(), g, Vector2::zeros(), DT2W, AREA);
+        assert_eq!(r.state, PairState::Stick);
+        assert!(r.r_n > 0.0, "compression is positive");
+        assert!((g + DT2W * r.r_n).abs() < 1e-20);
+    }
+
+    #[test]
+    fn stick_cancels_the_tangential_increment() {
+        // Reference: Δd_t = Δd̃_t + k r_t = 0 below the limit, to round-off.
+        let dt = Vector2::new(1e-8, -2e-8);
+        let r = pair_force(&law(0.6, 0.0, 0.0), &PairHistory::default(), -1e-6, dt, DT2W, AREA);
+        assert_eq!((r.state, r.state.code()), (PairState::Stick, 1));
+        assert!((dt + r.r_t * DT2W).norm() < 1e-22);
+        assert!(r.r_t.norm() <= 0.6 * r.r_n);
+        assert_eq!(r.slip_increment, Vector2::zeros());
+        assert_eq!(r.hist, PairHistory::default());
+    }
+
+    #[test]
+    fn slip_at_the_mohr_coulomb_limit() {
+        // Reference: |r_t| = μ r_n + c A exactly (relative 1e-14, round-off of the scaling),
+        // direction opposite to the trial slip (cosine −1 to 1e-14).
+        let l = law(0.6, 2e5, 0.0);
+        let g = -1e-7;
+        let dt = Vector2::new(3e-5, 4e-5);
+        let r = pair_force(&l, &PairHistory::default(), g, dt, DT2W, AREA);
+        assert_eq!((r.state, r.state.code()), (PairState::Slip, 2));
+        let expected = 0.6 * (-g / DT2W) + 2e5 * AREA;
+        assert!((r.r_t.norm() - expected).abs() <= 1e-14 * expected, "{} vs {expected}", r.r_t.norm());
+        let cos = r.r_t.dot(&dt) / (r.r_t.norm() * dt.norm());
+        assert!((cos + 1.0).abs() < 1e-14);
+        // The slip increment is the trial increment less what the limit force holds back.
+        let held = expected * DT2W;
+        assert!((r.slip_increment.norm() - (dt.norm() - held)).abs() < 1e-18);
+        assert!((r.hist.slip - r.slip_increment.norm()).abs() < 1e-20);
+        // Cohesion lost on this first slip.
+        assert!(!r.hist.intact);
+        // Next step, same trial: the limit is μ r_n only.
+        let r2 = pair_force(&l, &r.hist, g, dt, DT2W, AREA);
+        assert!((r2.r_t.norm() - 0.6 * (-g / DT2W)).abs() <= 1e-14 * r2.r_t.norm());
+        assert!(r2.hist.slip > r.hist.slip);
+    }
+
+    #[test]
+    fn cohesion_holds_until_first_slip_or_opening() {
+        // Without cohesion this trial slips; with c A it sticks and the bond survives.
+        let l = law(0.5, 1e5, 0.0);
+        let g = -1e-8;
+        let r_n = -g / DT2W;
+        let dt = Vector2::new(-(0.5 * r_n + 0.5e5 * AREA) * DT2W, 0.0); // trial force halfway into the cohesion
+        assert_eq!(pair_force(&law(0.5, 0.0, 0.0), &PairHistory::default(), g, dt, DT2W, AREA).state, PairState::Slip);
+        let r = pair_force(&l, &PairHistory::default(), g, dt, DT2W, AREA);
+        assert_eq!(r.state, PairState::Stick);
+        assert!(r.hist.intact);
+        // Opening loses it ...
+        let opened = pair_force(&l, &PairHistory::default(), 1e-9, dt, DT2W, AREA);
+        assert_eq!(opened.state, PairState::Open);
+        assert!(!opened.hist.intact);
+        assert_eq!(pair_force(&l, &opened.hist, g, dt, DT2W, AREA).state, PairState::Slip);
+        // ... unless keep_cohesion, which also keeps it through slip.
+        let keep = JointLaw { keep_cohesion: true, ..l.clone() };
+        assert!(pair_force(&keep, &PairHistory::default(), 1e-9, dt, DT2W, AREA).hist.intact);
+        let big = dt * 10.0;
+        let slip = pair_force(&keep, &PairHistory::default(), g, big, DT2W, AREA);
+        assert_eq!(slip.state, PairState::Slip);
+        assert!(slip.hist.intact);
+        assert!((slip.r_t.norm() - (0.5 * r_n + 1e5 * AREA)).abs() <= 1e-14 * slip.r_t.norm());
+        // A pair exactly touching (g̃ = 0) carries no force but is not opened.
+        let touch = pair_force(&l, &PairHistory::default(), 0.0, dt, DT2W, AREA);
+        assert_eq!(touch.state, PairState::Open);
+        assert!(touch.hist.intact);
+    }
+
+    #[test]
+    fn tension_up_to_strength_then_opening() {
+        // σ_t A = 1e6 Pa × 0.25 m² = 2.5e5 N. Reference: a bonded pair closes any trial gap
+        // while the tension −g̃/k stays within σ_t A (tolerance: round-off, 1e-20 m).
+        let l = law(0.6, 3e5, 1e6);
+        let limit = 1e6 * AREA;
+        let g_ok = 0.9 * limit * DT2W;
+        let r = pair_force(&l, &PairHistory::default(), g_ok, Vector2::zeros(), DT2W, AREA);
+        assert_eq!((r.state, r.state.code()), (PairState::Bonded, 3));
+        assert!(r.r_n < 0.0 && -r.r_n <= limit);
+        assert!((g_ok + DT2W * r.r_n).abs() < 1e-20);
+        assert!(r.hist.intact);
+        // Beyond σ_t A: rupture, open, bond lost for good (even with keep_cohesion).
+        for keep in [false, true] {
+            let l = JointLaw { keep_cohesion: keep, ..l.clone() };
+            let r = pair_force(&l, &PairHistory::default(), 1.1 * limit * DT2W, Vector2::zeros(), DT2W, AREA);
+            assert_eq!(r.state, PairState::Open);
+            assert_eq!(r.r_n, 0.0);
+            assert!(!r.hist.intact);
+            // Once broken, the same trial gap simply opens.
+            assert_eq!(pair_force(&l, &r.hist, g_ok, Vector2::zeros(), DT2W, AREA).state, PairState::Open);
+        }
+        // Shear beyond the (tension-reduced) limit breaks the bond; in tension the pair opens.
+        let shear = Vector2::new(1.0, 0.0) * (1e6 * DT2W);
+        let r = pair_force(&l, &PairHistory::default(), g_ok, shear, DT2W, AREA);
+        assert_eq!(r.state, PairState::Open);
+        assert!(!r.hist.intact);
+    }
+
+    #[test]
+    fn tied_always_sticks_and_never_opens() {
+        let l = JointLaw::tied();
+        for g in [-1e-6, 0.0, 1e-3] {
+            let dt = Vector2::new(1e-2, -3e-3);
+            let r = pair_force(&l, &PairHistory::default(), g, dt, DT2W, AREA);
+            assert_eq!(r.state, PairState::Bonded);
+            // Reference: both the gap and the tangential increment are closed exactly.
+            assert!((g + DT2W * r.r_n).abs() < 1e-18);
+            assert!((dt + DT2W * r.r_t).norm() < 1e-18);
+        }
+    }
+
+    #[test]
+    fn force_on_slave_signs() {
+        // Compression pushes the slave back against n; r_t maps onto (t1, t2).
+        let (n, t1, t2) = (Vector3::z(), Vector3::x(), Vector3::y());
+        let r = PairResponse {
+            r_n: 2.0,
+            r_t: Vector2::new(3.0, -1.0),
+            state: PairState::Slip,
+            hist: PairHistory::default(),
+            slip_increment: Vector2::zeros(),
+        };
+        assert_eq!(r.force_on_slave(&n, &t1, &t2), Vector3::new(3.0, -1.0, -2.0));
+    }
+
+    #[test]
+    fn validate_names_the_field() {
+        assert!(JointLaw::coulomb(0.7).validate().is_ok());
+        let e = JointLaw { cohesion: -1.0, ..JointLaw::coulomb(0.7) }.validate().unwrap_err();
+        assert_eq!(e.field, "cohesion");
+        assert!(JointLaw::coulomb(f64::NAN).validate().is_err());
+        // Serde: unknown keys are errors, optional fields default.
+        let l: JointLaw = serde_json::from_str(r#"{"mu": 0.6}"#).unwrap();
+        assert_eq!(l, JointLaw::coulomb(0.6));
+        assert!(serde_json::from_str::<JointLaw>(r#"{"mu": 0.6, "cohesoin": 1}"#).is_err());
+        assert_eq!(serde_json::to_string(&PairState::Slip).unwrap(), "\"slip\"");
+    }
+}
