@@ -25,5 +25,6 @@
 pub mod error;
 pub mod mesh;
 pub mod output;
+pub mod rigid;
 
 pub use error::{Error, Result};
