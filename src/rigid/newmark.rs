@@ -138,8 +138,7 @@ impl Incline {
     /// (β + φ ≥ 90°).
     pub fn yield_acceleration_up(&self) -> Result<Option<f64>, RigidError> {
         let m = self.model(Direction::TwoWay)?;
-        let up = m.up.expect("two-way model has an up law");
-        Ok((up.ch > 0.0).then(|| up.c0 / up.ch * m.g))
+        Ok(m.up.filter(|up| up.ch > 0.0).map(|up| up.c0 / up.ch * m.g))
     }
 }
 
@@ -443,4 +442,42 @@ pub fn slide_wedge(
     opts: &NewmarkOptions,
 ) -> Result<NewmarkResult, RigidError> {
     slide(&coeffs.sliding_model(direction), a_h, a_v, opts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_zero_picks_the_first_positive_root() {
+        // v + b s + a s^2: linear, two roots, start at zero, no root, beyond the interval.
+        assert_eq!(first_zero(1.0, -1.0, 0.0, 2.0), Some(1.0));
+        assert!((first_zero(1.0, -3.0, 2.0, 2.0).unwrap() - 0.5).abs() < 1e-15);
+        assert!((first_zero(0.0, 1.0, -1.0, 2.0).unwrap() - 1.0).abs() < 1e-15);
+        assert_eq!(first_zero(0.0, 0.0, 1.0, 2.0), None);
+        assert_eq!(first_zero(1.0, 0.0, 1.0, 2.0), None);
+        assert_eq!(first_zero(1.0, -1.0, 0.0, 0.5), None);
+        // v = 0 with r rising: no stop (the start of an episode).
+        assert_eq!(first_zero(0.0, 2.0, 1.0, 1.0), None);
+    }
+
+    #[test]
+    fn stop_and_restart_inside_one_interval() {
+        // Down law r = -1 + 2 kh (g = 1); kh ramps 1 -> 0 -> 1 over two unit steps.
+        // Sliding starts at t = 0 (r = 1), r falls linearly to -1 at t = 1: v = t - t^2,
+        // stops at t = 1 exactly; rises again from r = -1 to 1, restarts at t = 1.5.
+        let m = SlidingModel { down: Linear3::new(-1.0, 2.0, 0.0), up: None, normals: vec![], g: 1.0 };
+        let r = slide(&m, &[1.0, 0.0, 1.0], None, &NewmarkOptions::new(1.0).with_history()).unwrap();
+        let h = r.history.unwrap();
+        // d(1) = int_0^1 (t - t^2) dt = 1/6.
+        assert!((h[1] - 1.0 / 6.0).abs() < 1e-14, "{}", h[1]);
+        assert_eq!(r.n_episodes, 2);
+        // Episode 2: v = (t - 1.5)^2 to t = 2 (d 1/24), then the ramp to zero after the
+        // record (r from 1 to -1 over [2, 3]): v = 1/4 + s - s^2, peak 1/2 at t = 2.5,
+        // d 5/12; run-out at r0 = -1 from v = 1/4: d 1/32.
+        assert!((r.max_velocity - 0.5).abs() < 1e-14, "{}", r.max_velocity);
+        let d = 1.0 / 6.0 + 1.0 / 24.0 + 5.0 / 12.0 + 1.0 / 32.0;
+        assert!((r.residual_displacement - d).abs() < 1e-14, "{}", r.residual_displacement);
+        assert!(!r.still_sliding);
+    }
 }

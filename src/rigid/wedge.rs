@@ -273,7 +273,7 @@ pub fn build_wedge(input: &WedgeInput) -> Result<WedgeGeometry, RigidError> {
         });
     }
     let volume = (p - o).cross(&(qa - o)).dot(&(qb - o)).abs() / 6.0;
-    if !(volume > 0.0) {
+    if volume.is_nan() || volume <= 0.0 {
         return Err(RigidError::NotAWedge { reason: "the tetrahedron O P QA QB has no volume".into() });
     }
     let c = (o + p + qa + qb) / 4.0;
