@@ -518,3 +518,32 @@ fn wedge_geo_vertices_equal_limit_equilibrium_vertices() {
     }
     assert!(nearest_in("block:wedge", p1) < 1e-6);
 }
+
+#[test]
+#[ignore = "runs gmsh: GMSH=\"/path/to/python /path/to/gmsh\" cargo test --test all rigid -- --ignored"]
+fn wedge_geo_follows_its_parameters_gmsh() {
+    // Mesh wedge.geo with the crest-on-A height definition and another H; the mesh's wedge
+    // vertices must equal rigid::wedge's to 1e-6 m and its volume the LE volume to 1 %.
+    let cmd = std::env::var("GMSH").expect("set GMSH to the gmsh command (program and leading args)");
+    let mut parts = cmd.split_whitespace();
+    let out = crate::common::scratch("wedge_geo_params").join("w.msh");
+    let geo = concat!(env!("CARGO_MANIFEST_DIR"), "/geo/wedge.geo");
+    let status = std::process::Command::new(parts.next().unwrap())
+        .args(parts)
+        .args([geo, "-3", "-setnumber", "Hdef", "1", "-setnumber", "H", "30", "-setnumber", "hw", "10"])
+        .args(["-setnumber", "hr", "60", "-setnumber", "margin", "80", "-o"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .status()
+        .expect("cannot start gmsh");
+    assert!(status.success());
+    let mesh = Mesh::from_msh(&out).unwrap();
+    let input = WedgeInput { height: 30.0, height_def: HeightDef::CrestOnA, ..WedgeInput::default() };
+    let g = analyse_wedge(&input).unwrap().geometry;
+    let wn = mesh.group_nodes("block:wedge").unwrap();
+    for p in [g.o, g.p, g.qa, g.qb] {
+        let d = wn.iter().map(|&i| (0..3).map(|k| (mesh.nodes[i][k] - p[k]).powi(2)).sum::<f64>().sqrt()).fold(f64::INFINITY, f64::min);
+        assert!(d < 1e-6, "vertex {p:?}: nearest wedge node at {d} m");
+    }
+    assert!(rel(group_measure(&mesh, "block:wedge"), g.volume) < 0.01);
+}
