@@ -30,6 +30,7 @@ pub mod mesh;
 pub mod model;
 pub mod output;
 pub mod pipeline;
+pub mod rigid;
 pub mod scene;
 
 pub use error::{Error, Result};

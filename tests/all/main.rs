@@ -5,3 +5,4 @@
 mod common;
 mod dynamics;
 mod mesh;
+mod rigid;
