@@ -171,7 +171,11 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mut history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
     let mut frames = if scene.output.frames { Some(FrameWriter::create(&out_dir, scene.name(), &model)?) } else { None };
     let n_steps = (scene.time.duration / dt).round() as usize;
-    let frame_stride = scene.output.frame_stride.unwrap_or_else(|| (n_steps / 100).max(1));
+    let frame_stride = match (scene.output.frame_stride, scene.output.frame_interval) {
+        (Some(k), _) => k,
+        (None, Some(fi)) => ((fi / dt).round() as usize).max(1),
+        (None, None) => (n_steps / 100).max(1),
+    };
     let hist_stride = scene.output.history_stride.max(1);
 
     // ---- dynamic stage

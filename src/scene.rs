@@ -262,9 +262,12 @@ pub struct OutputSpec {
     /// Output directory. Default `out/<scene name>`.
     #[serde(default)]
     pub dir: Option<PathBuf>,
-    /// A VTU frame every `frame_stride` steps. Default: about 100 frames over the run.
+    /// A VTU frame every `frame_stride` steps (exclusive with `frame_interval`).
     #[serde(default)]
     pub frame_stride: Option<usize>,
+    /// A VTU frame every `frame_interval` seconds. Default: duration / 100 (about 100 frames).
+    #[serde(default)]
+    pub frame_interval: Option<f64>,
     /// History rows every `history_stride` steps. Default 1.
     #[serde(default = "one")]
     pub history_stride: usize,
@@ -285,7 +288,7 @@ fn yes() -> bool {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { dir: None, frame_stride: None, history_stride: 1, monitor: vec![], frames: true }
+        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: 1, monitor: vec![], frames: true }
     }
 }
 
@@ -442,6 +445,17 @@ impl Scene {
         }
         if self.time.dt.is_some() && self.time.courant.is_some() {
             return Err("time: give `dt` or `courant`, not both".into());
+        }
+        if self.output.frame_stride.is_some() && self.output.frame_interval.is_some() {
+            return Err("output: give `frame_stride` or `frame_interval`, not both".into());
+        }
+        if let Some(fi) = self.output.frame_interval {
+            if !(fi > 0.0 && fi.is_finite()) {
+                return Err(format!("output.frame_interval = {fi} must be positive [s]"));
+            }
+        }
+        if self.output.frame_stride == Some(0) {
+            return Err("output.frame_stride must be at least 1".into());
         }
         self.damping.coefficients()?;
         if !(self.g > 0.0) {

@@ -11,10 +11,9 @@
 //! ([`Correction`]). Fixed components keep relative displacement 0.
 //!
 //! Owns: [`State`] (what changes: t, u[n], u[n−1], energy account) and [`ExplicitSolver`]
-//! (scratch buffers only). Energy: E_err = KE + SE + D_α − E0 − W_ext − W_contact, with
-//! SE = ½ uᵀKu evaluated directly; stiffness-proportional dissipation is not subtracted, so
-//! with β > 0 the error drifts negative by that dissipation. Energy *appearing* (E_err above
-//! `energy_tolerance` × the energy scale) stops the run: it is the signature of instability.
+//! (scratch buffers only). Energy: E_err = KE + SE + D_α + D_β − E0 − W_ext − W_contact in the
+//! discrete energy of central differences (see `check_energy`); energy *appearing* (E_err above
+//! `energy_tolerance` × the energy scale) or unbounded growth stops the run.
 
 pub mod loads;
 pub mod record;
@@ -31,6 +30,8 @@ pub struct Energy {
     pub external_work: f64,
     pub contact_work: f64,
     pub mass_damping: f64,
+    /// Work of the stiffness-proportional damping forces βK v [J].
+    pub stiffness_damping: f64,
     /// KE + SE at the start of the stage.
     pub initial: f64,
     /// Largest |KE + SE| and |W_ext| seen: the scale of the relative error.
@@ -99,6 +100,9 @@ pub struct ExplicitSolver {
     f_ext: Vec<f64>,
     w: Vec<f64>,
     u_next: Vec<f64>,
+    /// K u[n] and K u[n−1] (recovered from K(u + βv_b) when β > 0, see `step`).
+    ku: Vec<f64>,
+    ku_prev: Vec<f64>,
     /// After a step: u[n−1] of the step just taken (state.u_prev is u[n], state.u is u[n+1]).
     pub u_nm1: Vec<f64>,
     /// Evaluate the energy balance every this many steps. Default 10.
@@ -116,6 +120,8 @@ impl ExplicitSolver {
             f_ext: vec![0.0; n],
             w: vec![0.0; n],
             u_next: vec![0.0; n],
+            ku: vec![0.0; n],
+            ku_prev: vec![0.0; n],
             u_nm1: vec![0.0; n],
             energy_stride: 10,
             energy_tolerance,
@@ -149,6 +155,11 @@ impl ExplicitSolver {
                 *w = u + c * (u - up);
             }
             model.internal_forces_into(&self.w, &mut self.f_int);
+            // f_int = (1 + c) K u[n] − c K u[n−1] by linearity, so K u[n] follows exactly from
+            // K u[n−1] (a recursion that damps its own round-off by c/(1+c) < 1 per step).
+            for i in 0..self.ku.len() {
+                self.ku[i] = (self.f_int[i] + c * self.ku_prev[i]) / (1.0 + c);
+            }
         } else {
             model.internal_forces_into(&state.u, &mut self.f_int);
         }
@@ -176,9 +187,13 @@ impl ExplicitSolver {
             let e = &mut state.energy;
             let mut wext = 0.0;
             let mut damp = 0.0;
+            let mut sdamp = 0.0;
             for i in 0..self.u_next.len() {
                 let du = 0.5 * (self.u_next[i] - state.u_prev[i]);
                 wext += du * self.f_ext[i];
+                if beta > 0.0 {
+                    sdamp += du * (self.f_int[i] - self.ku[i]);
+                }
                 if alpha > 0.0 {
                     let vb = (state.u[i] - state.u_prev[i]) / dt;
                     damp += du * alpha * model.mass[i / 3] * vb;
@@ -186,6 +201,7 @@ impl ExplicitSolver {
             }
             e.external_work += wext;
             e.mass_damping += damp;
+            e.stiffness_damping += sdamp;
             e.contact_work += info.correction.work;
         }
         // non-finite check (one pass)
@@ -200,6 +216,9 @@ impl ExplicitSolver {
                 x: model.mesh.nodes[node],
                 cause: "the time step is too large for the stiffest element or contact, or a load/record holds a non-finite value".into(),
             });
+        }
+        if beta > 0.0 {
+            std::mem::swap(&mut self.ku, &mut self.ku_prev);
         }
         // shift: u_nm1 ← u[n−1], u_prev ← u[n], u ← u[n+1]
         std::mem::swap(&mut self.u_nm1, &mut state.u_prev);
@@ -217,6 +236,7 @@ impl ExplicitSolver {
     pub fn start_energy(&mut self, model: &Model, state: &mut State) {
         self.u_nm1.copy_from_slice(&state.u_prev);
         model.internal_forces_into(&state.u, &mut self.w);
+        self.ku_prev.copy_from_slice(&self.w);
         let se = 0.5 * state.u.iter().zip(&self.w).map(|(u, f)| u * f).sum::<f64>();
         state.energy = Energy { strain: se, initial: se, scale: se.abs(), ..Energy::default() };
     }
@@ -237,9 +257,10 @@ impl ExplicitSolver {
             let v = (state.u[i] - state.u_prev[i]) / dt;
             ke += 0.5 * model.mass[i / 3] * v * v;
         }
-        // K u[n]: the step's internal force when β = 0, else evaluated here
+        // K u[n]: the step's internal force when β = 0, else the recovered one (after the swap
+        // at the end of the step it sits in ku_prev)
         if model.beta > 0.0 {
-            model.internal_forces_into(&state.u_prev, &mut self.w);
+            self.w.copy_from_slice(&self.ku_prev);
         } else {
             self.w.copy_from_slice(&self.f_int);
         }
@@ -253,12 +274,12 @@ impl ExplicitSolver {
         e.kinetic = ke;
         e.strain = se;
         e.scale = e.scale.max((ke + se).abs()).max(e.external_work.abs()).max(e.contact_work.abs()).max(e.initial.abs());
-        let bal = ke + se_mixed + e.mass_damping - e.initial - e.external_work - e.contact_work;
+        let bal = ke + se_mixed + e.mass_damping + e.stiffness_damping - e.initial - e.external_work - e.contact_work;
         e.error = if e.scale > 0.0 { bal / e.scale } else { 0.0 };
         if e.error.abs() > e.max_error.abs() {
             e.max_error = e.error;
         }
-        let reference = e.initial.abs() + e.external_work.abs() + e.contact_work.abs() + e.mass_damping.abs();
+        let reference = e.initial.abs() + e.external_work.abs() + e.contact_work.abs() + e.mass_damping.abs() + e.stiffness_damping.abs();
         let growth = reference > 0.0 && ke + se > 20.0 * reference;
         if (e.error > self.energy_tolerance || growth) && e.scale > 1e-300 {
             let (node, _) = (0..model.n_nodes())
