@@ -23,6 +23,7 @@
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages.
 
 pub mod error;
+pub mod interface;
 pub mod mesh;
 pub mod output;
 

@@ -3,3 +3,4 @@
 //! Physics tests state their reference and tolerance in a comment.
 
 mod common;
+mod tagging;
