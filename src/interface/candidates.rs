@@ -17,8 +17,11 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 /// Nearest master node (master-local index) and its distance [m] for each point, into the buffers.
 ///
-/// `tie` [m]: master nodes whose distance exceeds the smallest by less than `tie` count as equally
-/// near and the lowest index wins (`0.0` keeps whatever the tree returns first).
+/// `tie` [m]: a master node sharing a face with the tree's answer whose distance exceeds the
+/// smallest by less than `tie` counts as equally near, and the lowest index wins (`0.0` keeps the
+/// tree's answer). This settles the ties of structured meshes (a slave node at the centre of a
+/// master face, or midway along an edge) independently of the tree's internal order, without a
+/// second tree query. Results are deterministic in any case: each point is answered on its own.
 pub fn nearest_master_nodes_into(master: &Surface, points: &[[f64; 3]], tie: f64, nearest: &mut [u32], distance: &mut [f64]) {
     assert_eq!(points.len(), nearest.len());
     assert_eq!(points.len(), distance.len());
@@ -28,17 +31,27 @@ pub fn nearest_master_nodes_into(master: &Surface, points: &[[f64; 3]], tie: f64
     for ((p, o), d) in points.iter().zip(nearest.iter_mut()).zip(distance.iter_mut()) {
         let nn = tree.query(p).nearest_one::<SquaredEuclidean<f64>>().execute();
         let mut best = nn.item;
+        let dist = |l: u32| {
+            let x = master.points[l as usize];
+            dot(sub(*p, x), sub(*p, x)).sqrt()
+        };
+        let mut dbest = dist(best);
         if tie > 0.0 {
-            let r = nn.distance.sqrt() + tie;
-            tree.query(p).within::<SquaredEuclidean<f64>>(r * r).unsorted().visit(|q| {
-                if q.item < best {
-                    best = q.item;
+            let limit = dbest + tie;
+            for &f in master.faces_of_node(nn.item as usize) {
+                for &l in master.faces[f as usize].local_nodes() {
+                    if l < best {
+                        let dl = dist(l);
+                        if dl <= limit {
+                            best = l;
+                            dbest = dl;
+                        }
+                    }
                 }
-            });
+            }
         }
         *o = best;
-        let x = master.points[best as usize];
-        *d = dot(sub(*p, x), sub(*p, x)).sqrt();
+        *d = dbest;
     }
 }
 
@@ -56,26 +69,48 @@ pub fn layer2_candidates(master: &Surface, layer1: &Csr) -> Csr {
     let rows = layer1.rows();
     let mut csr = Csr::with_capacity(rows, 16 * rows);
     let mut buf: Vec<u32> = Vec::with_capacity(64);
+    // stamp[f] == i + 1 once face f is in row i: dedup without sorting duplicates
+    let mut stamp = vec![0u32; master.faces.len()];
     for i in 0..rows {
         buf.clear();
+        let mark = i as u32 + 1;
         for &f in layer1.row(i) {
             for &l in master.faces[f as usize].local_nodes() {
-                buf.extend_from_slice(master.faces_of_node(l as usize));
+                for &g in master.faces_of_node(l as usize) {
+                    if stamp[g as usize] != mark {
+                        stamp[g as usize] = mark;
+                        buf.push(g);
+                    }
+                }
             }
         }
         buf.sort_unstable();
-        buf.dedup();
         csr.push_row(&buf);
     }
     csr
 }
 
 /// Distance [m] from each point to the union of its Layer2 master faces, into `out`.
+///
+/// A face is skipped when the distance to its
+/// bounding sphere (centre = node average, radius = farthest node) is already ≥ the best distance.
 pub fn master_surface_distances_into(master: &Surface, points: &[[f64; 3]], layer2: &Csr, out: &mut [f64]) {
     assert_eq!(points.len(), out.len());
+    let spheres: Vec<([f64; 3], f64)> = (0..master.faces.len())
+        .map(|f| {
+            let (x, n) = master.face_points(f);
+            let c = scale(x[..n].iter().fold([0.0; 3], |s, &q| add(s, q)), 1.0 / n as f64);
+            let r = x[..n].iter().map(|&q| dot(sub(q, c), sub(q, c)).sqrt()).fold(0.0, f64::max);
+            (c, r * (1.0 + 1e-12))
+        })
+        .collect();
     for (i, (p, o)) in points.iter().zip(out.iter_mut()).enumerate() {
         let mut best = f64::INFINITY;
         for &f in layer2.row(i) {
+            let (c, r) = spheres[f as usize];
+            if dot(sub(*p, c), sub(*p, c)).sqrt() - r >= best {
+                continue;
+            }
             let (x, n) = master.face_points(f as usize);
             best = best.min(point_triangle_distance(*p, x[0], x[1], x[2]));
             if n == 4 {
