@@ -197,8 +197,10 @@ fn layers_on_structured_quad_master() {
 /// Structured tri3 master (each square split along its (i,j)–(i+1,j+1) diagonal, tet4 block) under a
 /// conforming quad slave. This mesh is topologically the regular triangular lattice: an interior
 /// node has 6 triangles (Layer1 = 6), and the 24 triangles of the two rings around it all touch
-/// the first ring (Layer2 = 24). Corner (0,0) lies on the diagonal of its square: 2 / 8; corner
-/// (1,0) is off it: 1 triangle, whose 3 nodes touch 1 + 3 + 2 = 6... checked by brute force below.
+/// the first ring (Layer2 = 24). Corner (0,0) lies on the diagonal of its square: 2 triangles, whose
+/// 4 nodes touch the 2 + 2 + 2 + 2 triangles of the 2×2 corner squares (Layer2 = 8). Corner (1,0) is
+/// off the diagonal: 1 triangle; its nodes (1−h,0), (1,0), (1,h) touch that square's 2 triangles,
+/// the lower triangle of the square to the left and of the square above (Layer2 = 4).
 #[test]
 fn layers_on_structured_tri_master() {
     let (mesh, s) = stacked(1.0, 6, 6, 0.0, true);
@@ -212,7 +214,7 @@ fn layers_on_structured_tri_master() {
         assert_eq!(j.layer2.row(i), layer2_brute(&j, i).as_slice());
     }
     let i = slave_at(&j, [1.0, 0.0, 0.0]);
-    assert_eq!(j.layer1.row_len(i), 1);
+    assert_eq!((j.layer1.row_len(i), j.layer2.row_len(i)), (1, 4));
     assert_eq!(j.layer2.row(i), layer2_brute(&j, i).as_slice());
 }
 
