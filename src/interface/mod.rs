@@ -33,10 +33,10 @@ pub use candidates::{
     layer1_candidates, layer2_candidates, master_surface_distances_into, nearest_master_nodes_into,
     point_triangle_distance,
 };
-pub use normals::{face_unit_normal, slave_normals_into, tributary_areas_into};
+pub use normals::{face_area, face_unit_normal, slave_normals_into, tributary_areas_into};
 pub use surface::{Face, Surface};
 pub use synthetic::flat_joint_mesh;
-pub use write::{write_joint_json, write_joint_vtu};
+pub use write::{JOINT_JSON_VERSION, write_joint_json, write_joint_vtu};
 
 use crate::error::InterfaceError;
 use crate::mesh::Mesh;
