@@ -6,3 +6,4 @@ mod common;
 mod dynamics;
 mod mesh;
 mod rigid;
+mod tagging;

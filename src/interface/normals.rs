@@ -1,0 +1,194 @@
+//! Face normals, slave-node normals and tributary areas (design.md §3 item 1).
+//!
+//! - Face normal: tri3 (x1 − x0) × (x2 − x0); quad4 at its centre, (x2 − x0) × (x3 − x1) (the
+//!   cross product of the diagonals, which is 4 × x_ξ × x_η at ξ = η = 0). Outward because face
+//!   nodes are in outward order ([`super::Surface`]).
+//! - Node normal: the normalised (unweighted) average of the outward unit normals of the faces
+//!   around the node.
+//! - Tributary area of node I: ∫ N_I dA over its faces. Tri3: area/3 per node (exact). Quad4:
+//!   2×2 Gauss on the bilinear map, exact for planar quads (N_I·detJ is then of degree ≤ 2 per
+//!   direction) and a consistent approximation for warped ones. The areas of a surface sum to its
+//!   area as computed by [`face_area`].
+
+use super::{Surface, invalid};
+use crate::error::InterfaceError;
+use crate::mesh::CellKind;
+
+#[inline]
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+#[inline]
+pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+#[inline]
+pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+#[inline]
+pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+#[inline]
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+#[inline]
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Unnormalised outward normal of a face with nodes `x` (outward order; 3 or 4 points used).
+#[inline]
+pub(crate) fn face_normal_raw(kind: CellKind, x: &[[f64; 3]]) -> [f64; 3] {
+    match kind {
+        CellKind::Quad4 => cross(sub(x[2], x[0]), sub(x[3], x[1])),
+        _ => cross(sub(x[1], x[0]), sub(x[2], x[0])),
+    }
+}
+
+/// Outward unit normal of a face (quad4: at its centre). Zero vector for a degenerate face.
+pub fn face_unit_normal(kind: CellKind, x: &[[f64; 3]]) -> [f64; 3] {
+    let n = face_normal_raw(kind, x);
+    let l = norm(n);
+    if l > 0.0 { scale(n, 1.0 / l) } else { [0.0; 3] }
+}
+
+/// 2×2 Gauss points (±1/√3, weights 1).
+const G: f64 = 0.577_350_269_189_625_8;
+const GAUSS2: [[f64; 2]; 4] = [[-G, -G], [G, -G], [G, G], [-G, G]];
+const QREF: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+
+/// ∫ N_I dA of each node of a quad4 (2×2 Gauss), into `out`.
+#[inline]
+pub(crate) fn quad_tributary(x: &[[f64; 3]], out: &mut [f64; 4]) {
+    *out = [0.0; 4];
+    for [xi, eta] in GAUSS2 {
+        let mut dxi = [0.0; 3];
+        let mut deta = [0.0; 3];
+        for (i, r) in QREF.iter().enumerate() {
+            dxi = add(dxi, scale(x[i], 0.25 * r[0] * (1.0 + eta * r[1])));
+            deta = add(deta, scale(x[i], 0.25 * r[1] * (1.0 + xi * r[0])));
+        }
+        let det = norm(cross(dxi, deta));
+        for (i, r) in QREF.iter().enumerate() {
+            out[i] += 0.25 * (1.0 + xi * r[0]) * (1.0 + eta * r[1]) * det;
+        }
+    }
+}
+
+/// Area of a face [m²]: tri3 exact, quad4 by 2×2 Gauss (exact when planar).
+pub fn face_area(kind: CellKind, x: &[[f64; 3]]) -> f64 {
+    match kind {
+        CellKind::Quad4 => {
+            let mut t = [0.0; 4];
+            quad_tributary(x, &mut t);
+            t.iter().sum()
+        }
+        _ => 0.5 * norm(face_normal_raw(kind, x)),
+    }
+}
+
+/// Outward unit normal at every node of `surface` (local node order) into `out`.
+///
+/// Error (naming the joint, the group and the node) when the face normals around a node cancel,
+/// which happens only on a folded surface.
+pub fn slave_normals_into(joint: &str, surface: &Surface, out: &mut [[f64; 3]]) -> Result<(), InterfaceError> {
+    assert_eq!(out.len(), surface.nodes.len());
+    let face_normals: Vec<[f64; 3]> = (0..surface.faces.len())
+        .map(|f| {
+            let (x, n) = surface.face_points(f);
+            face_unit_normal(surface.faces[f].kind, &x[..n])
+        })
+        .collect();
+    for (l, o) in out.iter_mut().enumerate() {
+        let s = surface.faces_of_node(l).iter().fold([0.0; 3], |s, &f| add(s, face_normals[f as usize]));
+        let len = norm(s);
+        if !(len > 1e-12) {
+            let p = surface.points[l];
+            return Err(invalid(
+                joint,
+                format!(
+                    "the faces of group \"{}\" around mesh node index {} at ({:.4}, {:.4}, {:.4}) have cancelling normals (a folded surface); \
+                     a joint side must be a surface with a consistent outward side",
+                    surface.group, surface.nodes[l], p[0], p[1], p[2]
+                ),
+            ));
+        }
+        *o = scale(s, 1.0 / len);
+    }
+    Ok(())
+}
+
+/// Tributary area [m²] of every node of `surface` (local node order) into `out`.
+pub fn tributary_areas_into(surface: &Surface, out: &mut [f64]) {
+    assert_eq!(out.len(), surface.nodes.len());
+    out.iter_mut().for_each(|a| *a = 0.0);
+    let mut t = [0.0; 4];
+    for (f, face) in surface.faces.iter().enumerate() {
+        let (x, n) = surface.face_points(f);
+        match face.kind {
+            CellKind::Quad4 => quad_tributary(&x, &mut t),
+            _ => t = [face_area(face.kind, &x[..3]) / 3.0; 4],
+        }
+        for (k, &l) in face.local_nodes().iter().enumerate().take(n) {
+            out[l as usize] += t[k];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Reference: 3×3 Gauss-Legendre (exact for degree ≤ 5 per direction) of N_I·|x_ξ × x_η| on a
+    /// planar trapezoid, where the integrand has degree ≤ 2 per direction. Tolerance 1e-14 relative.
+    #[test]
+    fn quad_tributary_matches_3x3_gauss_on_planar_trapezoid() {
+        let x = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.5, 1.0, 0.0], [0.3, 1.2, 0.0]];
+        let mut t = [0.0; 4];
+        quad_tributary(&x, &mut t);
+        let g3 = [(-(0.6f64).sqrt(), 5.0 / 9.0), (0.0, 8.0 / 9.0), ((0.6f64).sqrt(), 5.0 / 9.0)];
+        let mut r = [0.0; 4];
+        for &(xi, wx) in &g3 {
+            for &(eta, we) in &g3 {
+                let mut dxi = [0.0; 3];
+                let mut deta = [0.0; 3];
+                for (i, q) in QREF.iter().enumerate() {
+                    dxi = add(dxi, scale(x[i], 0.25 * q[0] * (1.0 + eta * q[1])));
+                    deta = add(deta, scale(x[i], 0.25 * q[1] * (1.0 + xi * q[0])));
+                }
+                let det = norm(cross(dxi, deta));
+                for (i, q) in QREF.iter().enumerate() {
+                    r[i] += wx * we * 0.25 * (1.0 + xi * q[0]) * (1.0 + eta * q[1]) * det;
+                }
+            }
+        }
+        // shoelace area of the trapezoid
+        let shoelace = 0.5 * (0..4).map(|i| x[i][0] * x[(i + 1) % 4][1] - x[(i + 1) % 4][0] * x[i][1]).sum::<f64>();
+        for i in 0..4 {
+            assert!((t[i] - r[i]).abs() < 1e-14 * shoelace, "node {i}: {} vs {}", t[i], r[i]);
+        }
+        assert!((t.iter().sum::<f64>() - shoelace).abs() < 1e-14 * shoelace);
+        // not the naive quarter: the trapezoid's nodes carry different shares
+        assert!((t[0] - t[2]).abs() > 1e-3);
+    }
+
+    /// The quad normal at the centre (cross product of the diagonals) of a warped quad equals
+    /// x_ξ × x_η at ξ = η = 0 up to the factor 4 (definition), checked on a hyperbolic paraboloid patch.
+    #[test]
+    fn quad_normal_is_centre_normal() {
+        let x = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [1.0, 1.0, 0.0], [0.0, 1.0, 0.1]];
+        let n = face_unit_normal(CellKind::Quad4, &x);
+        let mut dxi = [0.0; 3];
+        let mut deta = [0.0; 3];
+        for (i, q) in QREF.iter().enumerate() {
+            dxi = add(dxi, scale(x[i], 0.25 * q[0]));
+            deta = add(deta, scale(x[i], 0.25 * q[1]));
+        }
+        let c = cross(dxi, deta);
+        let c = scale(c, 1.0 / norm(c));
+        assert!(norm(sub(n, c)) < 1e-15);
+    }
+}
