@@ -1,7 +1,9 @@
 //! The recipe: the only function that sequences the stages (scene → mesh → model → loads →
 //! equilibrium → dynamic run → outputs). Each stage is timed into `summary.json`.
 
-use crate::dynamics::{relax_gravity, loads::Loads, EquilibriumInfo, ExplicitSolver, Stage, State};
+use crate::contact::force::ContactSolver;
+use crate::dynamics::{relax_gravity, loads::Loads, Correction, EquilibriumInfo, ExplicitSolver, Stage, State};
+use crate::output::joints::{JointPeaks, JointWriter};
 use crate::error::{Error, ModelError};
 use crate::mesh::Mesh;
 use crate::model::Model;
@@ -57,6 +59,10 @@ pub struct RunSummary {
     pub out_dir: PathBuf,
     pub pvd: Option<PathBuf>,
     pub histories: Vec<PathBuf>,
+    /// Joint-surface series (one `.pvd` per joint).
+    pub joint_series: Vec<PathBuf>,
+    /// Joint maxima and search/Gauss–Seidel diagnostics.
+    pub joints: Vec<JointPeaks>,
     pub notes: Vec<String>,
     /// Stage wall times [s].
     pub timings: Vec<(String, f64)>,
@@ -115,13 +121,6 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     };
     let mut t = Instant::now();
     let scene = Scene::load(scene_path)?;
-    if !scene.joints.is_empty() {
-        return Err(ModelError::Invalid(format!(
-            "scene {} declares joints; contact is not available in this build (see the contact issue)",
-            scene_path.display()
-        ))
-        .into());
-    }
     let mesh = load_mesh(&scene, opts)?;
     let mesh_path = mesh.source.clone();
     lap("mesh", &mut t);
@@ -129,8 +128,16 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let (loads, mut notes) = Loads::build(&model, &scene)?;
     lap("model", &mut t);
 
-    // ---- time step
-    let dt_stable = model.stable_dt();
+    let mut contact = if model.joints.is_empty() { None } else { Some(ContactSolver::new(&model, &model.joints)) };
+
+    // ---- time step (penalty springs add their stiffness to the highest frequency)
+    let pen_w2 = contact.as_ref().map(|c| c.penalty_omega2_bound(&model)).unwrap_or(0.0);
+    let dt_stable = if pen_w2 > 0.0 {
+        notes.push(format!("penalty springs: stable step reduced from {:.4e} s", model.stable_dt()));
+        model.stable_dt_with(pen_w2)
+    } else {
+        model.stable_dt()
+    };
     let dt = match scene.time.dt {
         Some(dt) => {
             if dt > dt_stable {
@@ -144,8 +151,16 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mut state = State::at_rest(&model);
 
     // ---- gravity equilibrium
-    let equilibrium = if loads.gravity.is_some() {
-        let eq = relax_gravity(&model, &loads, &mut solver, &mut state, None, scene.equilibrium.tolerance, scene.equilibrium.max_steps)?;
+    let equilibrium = if loads.gravity.is_some() && scene.equilibrium.method == "relaxation" {
+        let eq = relax_gravity(
+            &model,
+            &loads,
+            &mut solver,
+            &mut state,
+            contact.as_mut().map(|c| c as &mut dyn Correction),
+            scene.equilibrium.tolerance,
+            scene.equilibrium.max_steps,
+        )?;
         if !eq.converged && eq.residual > scene.equilibrium.max_residual {
             return Err(ModelError::Invalid(format!(
                 "gravity equilibrium not reached in {} steps: residual {:.2e} > max_residual {:.1e}. Raise equilibrium.max_steps or check supports (a block without supports or contact falls freely).",
@@ -158,6 +173,13 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         }
         state.step = 0;
         state.t = 0.0;
+        // slip during equilibration is not seismic slip: restart the joint counters from here
+        for r in &mut state.contact.joints {
+            for p in &mut r.pairs {
+                p.slip = 0.0;
+                p.d_t = [0.0; 2];
+            }
+        }
         Some(eq)
     } else {
         None
@@ -170,6 +192,7 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let monitors = snap_monitors(&model, &scene)?;
     let mut history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
     let mut frames = if scene.output.frames { Some(FrameWriter::create(&out_dir, scene.name(), &model)?) } else { None };
+    let mut joint_out = if model.joints.is_empty() { None } else { Some(JointWriter::create(&out_dir, &model.joints, scene.output.frames)?) };
     let n_steps = (scene.time.duration / dt).round() as usize;
     let frame_stride = match (scene.output.frame_stride, scene.output.frame_interval) {
         (Some(k), _) => k,
@@ -195,7 +218,7 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mut peak = Peak::default();
     let mut rows = vec![[0.0; 9]; monitors.len()];
     for k in 0..n_steps {
-        solver.step(&model, &loads, &mut state, Stage::Dynamic, None)?;
+        solver.step(&model, &loads, &mut state, Stage::Dynamic, contact.as_mut().map(|c| c as &mut dyn Correction))?;
         // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt
         let kin = Kinematics { t: state.t - dt, dt, u_prev: &solver.u_nm1, u: &state.u_prev, u_next: &state.u };
         if k % hist_stride == 0 {
@@ -208,6 +231,9 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
                 }
             }
             history.row(kin.t, &rows)?;
+            if let Some(jw) = joint_out.as_mut() {
+                jw.record(state.t, &model.joints, &state.contact)?;
+            }
         }
         if k % 10 == 0 || k + 1 == n_steps {
             for n in 0..model.n_nodes() {
@@ -221,6 +247,9 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
             if let Some(f) = frames.as_mut() {
                 f.write(&model, &kin)?;
             }
+            if let Some(jw) = joint_out.as_mut() {
+                jw.write_frame(state.t, &model.joints, &state.contact, &state.u)?;
+            }
             history.flush()?;
         }
         if k % 64 == 0 {
@@ -230,6 +259,9 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     }
     bar.finish_and_clear();
     history.flush()?;
+    if let Some(jw) = joint_out.as_mut() {
+        jw.write_frame(state.t, &model.joints, &state.contact, &state.u)?;
+    }
     lap("dynamic", &mut t);
 
     let summary = RunSummary {
@@ -253,7 +285,9 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         monitors,
         frames: frames.as_ref().map(|f| f.series.len()).unwrap_or(0),
         pvd: frames.as_ref().map(|f| f.series.path().to_path_buf()),
-        histories: history.paths(),
+        histories: history.paths().into_iter().chain(joint_out.as_ref().map(|j| j.csv_paths()).unwrap_or_default()).collect(),
+        joint_series: joint_out.as_ref().map(|j| j.pvd_paths()).unwrap_or_default(),
+        joints: joint_out.as_ref().map(|j| j.peaks.clone()).unwrap_or_default(),
         out_dir: out_dir.clone(),
         notes,
         timings,
@@ -290,6 +324,18 @@ impl RunSummary {
         for m in &self.monitors {
             let _ = writeln!(s, "  monitor {:8} node {} ({:.3e} m from the requested point)", m.name, m.node_tag, m.snap_distance);
         }
+        for j in &self.joints {
+            let _ = writeln!(
+                s,
+                "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {}{}",
+                j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps,
+                if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
+            );
+            let e = &j.events;
+            if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures > 0 {
+                let _ = writeln!(s, "                 search: {} Layer2 widenings, {} fresh searches, {} node-steps lost, {} projection failures", e.widened_layer2, e.fresh_searches, e.lost, e.projection_failures);
+            }
+        }
         for n in &self.notes {
             let _ = writeln!(s, "  note            {n}");
         }
@@ -298,6 +344,9 @@ impl RunSummary {
         let _ = writeln!(s, "results in {}", self.out_dir.display());
         if let Some(p) = &self.pvd {
             let _ = writeln!(s, "  ParaView series {} ({} frames)", p.display(), self.frames);
+        }
+        for p in &self.joint_series {
+            let _ = writeln!(s, "  joint series    {}", p.display());
         }
         for h in &self.histories {
             let _ = writeln!(s, "  history         {}", h.display());

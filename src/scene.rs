@@ -229,6 +229,10 @@ fn default_energy_tol() -> f64 {
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct EquilibriumSpec {
+    /// "relaxation" (default when gravity is on): bring gravity to equilibrium before the
+    /// dynamic stage; "none": gravity acts from t = 0 in the dynamic stage (sliding from rest).
+    #[serde(default = "relaxation")]
+    pub method: String,
     /// Relative residual ‖F − K u‖/‖F‖ at which relaxation stops. Default 1e-6.
     #[serde(default = "default_eq_tol")]
     pub tolerance: f64,
@@ -240,6 +244,9 @@ pub struct EquilibriumSpec {
     pub max_steps: usize,
 }
 
+fn relaxation() -> String {
+    "relaxation".into()
+}
 fn default_eq_tol() -> f64 {
     1e-6
 }
@@ -252,7 +259,7 @@ fn default_eq_steps() -> usize {
 
 impl Default for EquilibriumSpec {
     fn default() -> Self {
-        EquilibriumSpec { tolerance: default_eq_tol(), max_residual: default_eq_max_res(), max_steps: default_eq_steps() }
+        EquilibriumSpec { method: relaxation(), tolerance: default_eq_tol(), max_residual: default_eq_max_res(), max_steps: default_eq_steps() }
     }
 }
 
@@ -445,6 +452,9 @@ impl Scene {
         }
         if self.time.dt.is_some() && self.time.courant.is_some() {
             return Err("time: give `dt` or `courant`, not both".into());
+        }
+        if !matches!(self.equilibrium.method.as_str(), "relaxation" | "none") {
+            return Err(format!("equilibrium.method \"{}\" is not \"relaxation\" or \"none\"", self.equilibrium.method));
         }
         if self.output.frame_stride.is_some() && self.output.frame_interval.is_some() {
             return Err("output: give `frame_stride` or `frame_interval`, not both".into());

@@ -38,5 +38,7 @@
 //! the order of the candidates; a law response closes the trial gap exactly in compression and
 //! never exceeds the Mohr-Coulomb limit in shear.
 
+pub mod force;
+pub mod joint;
 pub mod law;
 pub mod query;

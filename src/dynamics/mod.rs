@@ -53,12 +53,21 @@ pub struct State {
     /// u[n−1].
     pub u_prev: Vec<f64>,
     pub energy: Energy,
+    /// Contact history of every joint (empty without joints).
+    pub contact: crate::contact::force::ContactState,
 }
 
 impl State {
     pub fn at_rest(model: &Model) -> State {
         let n = 3 * model.n_nodes();
-        State { step: 0, t: 0.0, u: vec![0.0; n], u_prev: vec![0.0; n], energy: Energy::default() }
+        State {
+            step: 0,
+            t: 0.0,
+            u: vec![0.0; n],
+            u_prev: vec![0.0; n],
+            energy: Energy::default(),
+            contact: crate::contact::force::ContactState::new(&model.joints),
+        }
     }
 }
 
@@ -73,8 +82,19 @@ pub struct CorrectionInfo {
 
 /// A correction applied to the contact-free prediction u[n+1] (the dynamic contact force).
 pub trait Correction {
-    /// `u_prev` = u[n−1], `u` = u[n], `u_next` = predicted u[n+1] (corrected in place).
-    fn correct(&mut self, model: &Model, t_next: f64, dt: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> Result<CorrectionInfo, StepError>;
+    /// `u_prev` = u[n−1], `u` = u[n], `u_next` = predicted u[n+1] (corrected in place);
+    /// `history` is the contact part of the state, updated in place.
+    #[allow(clippy::too_many_arguments)]
+    fn correct(
+        &mut self,
+        model: &Model,
+        history: &mut crate::contact::force::ContactState,
+        t_next: f64,
+        dt: f64,
+        u_prev: &[f64],
+        u: &[f64],
+        u_next: &mut [f64],
+    ) -> Result<CorrectionInfo, StepError>;
 }
 
 /// Non-fatal information about one step.
@@ -180,7 +200,7 @@ impl ExplicitSolver {
         }
         let mut info = StepInfo::default();
         if let Some(c) = correction {
-            info.correction = c.correct(model, state.t + dt, dt, &state.u_prev, &state.u, &mut self.u_next)?;
+            info.correction = c.correct(model, &mut state.contact, state.t + dt, dt, &state.u_prev, &state.u, &mut self.u_next)?;
         }
         // energy increments over the step: Δu_c = (u[n+1] − u[n−1]) / 2
         if dynamic {

@@ -75,6 +75,8 @@ pub struct Model {
     pub alpha: f64,
     pub beta: f64,
     pub critical: CriticalElement,
+    /// Joints (tagged interfaces with their laws), in scene order.
+    pub joints: Vec<crate::contact::joint::ContactJoint>,
 }
 
 /// Scatter target shared across threads. Safe use requires that no two concurrent writers touch
@@ -243,6 +245,21 @@ impl Model {
             }
         }
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
+        // ---- joints (tagged once on the initial configuration)
+        let size = {
+            let (lo, hi) = mesh.nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(mut lo, mut hi), x| {
+                for i in 0..3 {
+                    lo[i] = lo[i].min(x[i]);
+                    hi[i] = hi[i].max(x[i]);
+                }
+                (lo, hi)
+            });
+            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+        };
+        let mut joints = Vec::new();
+        for js in &scene.joints {
+            joints.push(crate::contact::joint::ContactJoint::build(&mesh, js, size)?);
+        }
 
         let mut model = Model {
             mesh,
@@ -254,6 +271,7 @@ impl Model {
             alpha,
             beta,
             critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
+            joints,
         };
         model.critical = model.max_element_eigenvalue();
         Ok(model)
@@ -311,6 +329,14 @@ impl Model {
     /// the largest dt with ω²dt² + 2(α + βω²) dt − 4 ≤ 0 at ω = ω_max (undamped: 2/ω_max).
     pub fn stable_dt(&self) -> f64 {
         let w2 = self.critical.omega2;
+        let c = self.alpha + self.beta * w2;
+        (-c + (c * c + 4.0 * w2).sqrt()) / w2
+    }
+
+    /// Stable step with an extra ω² bound `extra_omega2` [1/s²] added to the element bound
+    /// (λ_max(A + B) ≤ λ_max(A) + λ_max(B)), e.g. for penalty springs.
+    pub fn stable_dt_with(&self, extra_omega2: f64) -> f64 {
+        let w2 = self.critical.omega2 + extra_omega2;
         let c = self.alpha + self.beta * w2;
         (-c + (c * c + 4.0 * w2).sqrt()) / w2
     }

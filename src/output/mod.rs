@@ -7,6 +7,7 @@
 pub mod vtu;
 pub mod frames;
 pub mod history;
+pub mod joints;
 pub mod pvd;
 
 /// Principal stresses σ1 ≥ σ2 ≥ σ3 [Pa] of a Voigt stress (xx, yy, zz, xy, yz, zx).

@@ -1,0 +1,546 @@
+//! The dynamic contact force on the model (design §5): search, pair forces, Gauss–Seidel.
+//!
+//! Each step, after the contact-free prediction ũ[n+1]:
+//! 1. **Search** (per slave node): project x̃_s along its normal n onto the candidate master
+//!    faces at their predicted positions (inside-outside, [`super::query`]). Candidates are the
+//!    Layer1 (or Layer2) faces around the pair's *centre* master node, initially the tagger's O.
+//!    If the projection leaves them: `widen` tries Layer2, then walks the master surface to the
+//!    node nearest the slave's current relative position and makes it the new centre; `report`
+//!    counts the node and gives it no force that step. NTN pairs the slave with O (N = [1]).
+//! 2. **Pair force**: trial gap g̃ and tangential increment Δd̃_t with the pair's own force
+//!    removed, then [`super::law::pair_force`] (closes the gap exactly, Mohr-Coulomb in shear).
+//! 3. **Gauss–Seidel**: pairs that share master nodes are coupled; sweeps repeat the pair updates
+//!    until the largest change of gap in a sweep is below `gs_tolerance` (or `gs_max_sweeps`).
+//!
+//! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 for a node with any fixed component (a fixed
+//! node does not move under contact forces; free components of partly fixed nodes are treated
+//! as fixed for the pair mobility, and the correction is applied to free components only).
+//!
+//! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal force
+//! kn A max(0, −g), tangential elastic spring kt A with the same Mohr-Coulomb cap, applied as an
+//! external force of step n (so it is explicit and lowers the stable step).
+
+use super::joint::{ContactJoint, Method, OnExit};
+use super::law::{pair_force, PairHistory, PairState};
+use super::query::{select_projection, INSIDE_TOL_DEFAULT};
+use crate::dynamics::{Correction, CorrectionInfo};
+use crate::error::StepError;
+use crate::model::Model;
+use nalgebra::{Vector2, Vector3};
+
+/// What changes for one pair (slave node) from step to step.
+#[derive(Clone, Copy, Debug)]
+pub struct PairRecord {
+    pub hist: PairHistory,
+    pub state: PairState,
+    /// Master-local node around which candidate faces are taken (starts at the tagger's O).
+    pub center: u32,
+    /// Master face of the last projection (−1: none).
+    pub face: i32,
+    /// Gap at the end of the last step [m] (NaN when the node found no face).
+    pub gap: f64,
+    /// Normal (compressive, N) and tangential (N, in t1/t2) force of the last step.
+    pub r_n: f64,
+    pub r_t: [f64; 2],
+    /// Accumulated relative tangential displacement vector d_t (t1, t2) [m].
+    pub d_t: [f64; 2],
+    /// Accumulated tangential relative path Σ|Δd_t| [m] (the joint's slip).
+    pub slip: f64,
+}
+
+/// Counters of search events per joint.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct SearchEvents {
+    /// Projections found only in Layer2 after leaving Layer1.
+    pub widened_layer2: u64,
+    /// Fresh nearest-node searches (the centre moved).
+    pub fresh_searches: u64,
+    /// Node-steps with no master face found (force-free that step).
+    pub lost: u64,
+    /// Quad projections that did not converge (the face was skipped).
+    pub projection_failures: u64,
+}
+
+/// Contact history of one joint.
+#[derive(Clone, Debug, Default)]
+pub struct JointRecord {
+    pub pairs: Vec<PairRecord>,
+    pub events: SearchEvents,
+    /// Gauss–Seidel sweeps of the last step and the largest so far.
+    pub sweeps: usize,
+    pub max_sweeps: usize,
+    /// Steps whose Gauss–Seidel did not reach the tolerance.
+    pub unconverged_steps: u64,
+}
+
+/// Contact history of all joints (part of the run's `State`).
+#[derive(Clone, Debug, Default)]
+pub struct ContactState {
+    pub joints: Vec<JointRecord>,
+}
+
+impl ContactState {
+    pub fn new(joints: &[ContactJoint]) -> ContactState {
+        ContactState {
+            joints: joints
+                .iter()
+                .map(|j| JointRecord {
+                    pairs: (0..j.tag.n_slave())
+                        .map(|i| PairRecord {
+                            hist: PairHistory::default(),
+                            state: PairState::Open,
+                            center: j.tag.nearest[i],
+                            face: -1,
+                            gap: f64::NAN,
+                            r_n: 0.0,
+                            r_t: [0.0; 2],
+                            d_t: [0.0; 2],
+                            slip: 0.0,
+                        })
+                        .collect(),
+                    ..Default::default()
+                })
+                .collect(),
+        }
+    }
+}
+
+/// One active pair of the current step (scratch).
+#[derive(Clone, Copy, Debug)]
+struct Active {
+    joint: u32,
+    pair: u32,
+    slave: u32,
+    masters: [u32; 4],
+    nm: u8,
+    weights: [f64; 4],
+    dt2w: f64,
+    /// Applied force components (r_n compressive, r_t) of the current Gauss–Seidel iterate.
+    r_n: f64,
+    r_t: Vector2<f64>,
+    hist: PairHistory,
+    state: PairState,
+    gap: f64,
+}
+
+/// Scratch and settings of the contact correction. Holds no history (that is in `ContactState`).
+pub struct ContactSolver<'m> {
+    pub joints: &'m [ContactJoint],
+    /// Gauss–Seidel stops when the largest gap change of a sweep is below this [m].
+    /// Default 1e-12 × the largest joint size: far below any physical gap.
+    pub gs_tolerance: f64,
+    /// Sweep budget per step. Default 200.
+    pub gs_max_sweeps: usize,
+    active: Vec<Active>,
+    penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
+    inv_mass: Vec<f64>,
+    cand: Vec<u32>,
+}
+
+impl<'m> ContactSolver<'m> {
+    pub fn new(model: &Model, joints: &'m [ContactJoint]) -> ContactSolver<'m> {
+        let size = joints.iter().map(|j| j.tag.size).fold(0.0, f64::max);
+        let inv_mass = (0..model.n_nodes())
+            .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
+            .collect();
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, active: Vec::new(), penalty: Vec::new(), inv_mass, cand: Vec::new() }
+    }
+
+    /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
+    /// with full weights at the nodes of the initial centre's faces) [1/s²]; 0 without penalty joints.
+    pub fn penalty_omega2_bound(&self, model: &Model) -> f64 {
+        let mut row = vec![0.0; model.n_nodes()];
+        for j in self.joints {
+            let Method::Penalty { kn, kt } = j.method else { continue };
+            let k = kn.max(kt);
+            for i in 0..j.tag.n_slave() {
+                let s = j.tag.slave_nodes()[i];
+                let o = j.tag.nearest_master_node(i);
+                let ka = k * j.tag.areas[i];
+                // spring between s and o (worst case: all weight on one master node)
+                let (bs, bo) = (self.inv_mass[s].sqrt(), self.inv_mass[o].sqrt());
+                row[s] += ka * bs * (bs + bo);
+                row[o] += ka * bo * (bs + bo);
+            }
+        }
+        row.into_iter().fold(0.0, f64::max)
+    }
+
+    fn candidates_into(&mut self, j: &ContactJoint, center: u32, layer: u8) {
+        self.cand.clear();
+        let m = &j.tag.master;
+        for &f in m.faces_of_node(center as usize) {
+            self.cand.push(f);
+        }
+        if layer >= 2 {
+            let l1 = self.cand.clone();
+            for f in l1 {
+                for &v in m.faces[f as usize].local_nodes() {
+                    for &g in m.faces_of_node(v as usize) {
+                        self.cand.push(g);
+                    }
+                }
+            }
+            self.cand.sort_unstable();
+            self.cand.dedup();
+        }
+    }
+}
+
+#[inline]
+fn pos(model: &Model, u: &[f64], n: usize) -> Vector3<f64> {
+    let x = model.mesh.nodes[n];
+    Vector3::new(x[0] + u[3 * n], x[1] + u[3 * n + 1], x[2] + u[3 * n + 2])
+}
+
+#[inline]
+fn disp(u: &[f64], n: usize) -> Vector3<f64> {
+    Vector3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2])
+}
+
+/// Project slave node `i` of joint `j` on the master faces `faces` at the positions `u`.
+fn project_on(
+    model: &Model,
+    j: &ContactJoint,
+    faces: &[u32],
+    xs: &Vector3<f64>,
+    n: &Vector3<f64>,
+    u: &[f64],
+    failures: &mut u64,
+) -> Option<(usize, super::query::Projection)> {
+    let m = &j.tag.master;
+    let mut pts: Vec<(usize, [Vector3<f64>; 4], usize)> = Vec::with_capacity(faces.len());
+    for &f in faces {
+        let face = &m.faces[f as usize];
+        let nodes = face.nodes();
+        let mut x = [Vector3::zeros(); 4];
+        for (a, &nd) in nodes.iter().enumerate() {
+            x[a] = pos(model, u, nd as usize);
+        }
+        pts.push((f as usize, x, nodes.len()));
+    }
+    match select_projection(xs, n, pts.iter().map(|(f, x, k)| (*f, &x[..*k])), INSIDE_TOL_DEFAULT) {
+        Ok(p) => p,
+        Err(_) => {
+            // a face whose quad solve failed: retry without the failing faces one by one
+            *failures += 1;
+            let mut best: Option<(usize, super::query::Projection)> = None;
+            for (f, x, k) in &pts {
+                if let Ok(Some((ff, p))) = select_projection(xs, n, std::iter::once((*f, &x[..*k])), INSIDE_TOL_DEFAULT) {
+                    best = match best {
+                        Some((bf, bp)) if bp.t.abs() <= p.t.abs() => Some((bf, bp)),
+                        _ => Some((ff, p)),
+                    };
+                }
+            }
+            best
+        }
+    }
+}
+
+impl Correction for ContactSolver<'_> {
+    fn correct(
+        &mut self,
+        model: &Model,
+        history: &mut ContactState,
+        _t_next: f64,
+        dt: f64,
+        u_prev: &[f64],
+        u: &[f64],
+        u_next: &mut [f64],
+    ) -> Result<CorrectionInfo, StepError> {
+        let dt2 = dt * dt;
+        self.active.clear();
+        self.penalty.clear();
+        let mut penalty_work = 0.0;
+        // ---------------------------------------------------------------- search
+        for (ji, j) in self.joints.iter().enumerate() {
+            let rec = &mut history.joints[ji];
+            let penalty = matches!(j.method, Method::Penalty { .. });
+            // penalty works on the configuration at t[n]; the dynamic force on the prediction
+            let conf: &[f64] = if penalty { u } else { u_next };
+            for i in 0..j.tag.n_slave() {
+                let s = j.tag.slave_nodes()[i];
+                let [n, t1, t2] = j.frames[i];
+                let xs = pos(model, conf, s);
+                let pr = rec.pairs[i];
+                let (masters, nm, weights, face) = match j.method {
+                    Method::Ntn => {
+                        let o = j.tag.nearest_master_node(i) as u32;
+                        ([o, 0, 0, 0], 1u8, [1.0, 0.0, 0.0, 0.0], -1i32)
+                    }
+                    _ => {
+                        self.candidates_into(j, pr.center, j.layer);
+                        let mut found = {
+                            let cand = std::mem::take(&mut self.cand);
+                            let r = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures);
+                            self.cand = cand;
+                            r
+                        };
+                        if found.is_none() && j.on_exit == OnExit::Widen {
+                            if j.layer < 2 {
+                                self.candidates_into(j, pr.center, 2);
+                                let cand = std::mem::take(&mut self.cand);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures);
+                                self.cand = cand;
+                                if found.is_some() {
+                                    rec.events.widened_layer2 += 1;
+                                }
+                            }
+                            if found.is_none() {
+                                // walk the master surface to the node nearest the slave's position
+                                let m = &j.tag.master;
+                                let mut c = pr.center as usize;
+                                let d = |l: usize| (pos(model, conf, m.nodes[l]) - xs).norm_squared();
+                                loop {
+                                    let mut best = (d(c), c);
+                                    for &f in m.faces_of_node(c) {
+                                        for &v in m.faces[f as usize].local_nodes() {
+                                            let dv = d(v as usize);
+                                            if dv < best.0 || (dv == best.0 && (v as usize) < best.1) {
+                                                best = (dv, v as usize);
+                                            }
+                                        }
+                                    }
+                                    if best.1 == c {
+                                        break;
+                                    }
+                                    c = best.1;
+                                }
+                                rec.events.fresh_searches += 1;
+                                rec.pairs[i].center = c as u32;
+                                self.candidates_into(j, c as u32, 2);
+                                let cand = std::mem::take(&mut self.cand);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures);
+                                self.cand = cand;
+                            }
+                        }
+                        match found {
+                            Some((f, p)) => {
+                                // keep the candidate set centred on the node the slave is nearest to
+                                let local = j.tag.master.faces[f].local_nodes();
+                                let (mut best, mut wmax) = (local[0], f64::MIN);
+                                for (a, &l) in local.iter().enumerate() {
+                                    if p.weights[a] > wmax {
+                                        wmax = p.weights[a];
+                                        best = l;
+                                    }
+                                }
+                                rec.pairs[i].center = best;
+                                let nodes = j.tag.master.faces[f].nodes();
+                                let mut ms = [0u32; 4];
+                                for (a, &nd) in nodes.iter().enumerate() {
+                                    ms[a] = nd;
+                                }
+                                (ms, nodes.len() as u8, p.weights, f as i32)
+                            }
+                            None => {
+                                rec.events.lost += 1;
+                                let p = &mut rec.pairs[i];
+                                p.face = -1;
+                                p.gap = f64::NAN;
+                                p.r_n = 0.0;
+                                p.r_t = [0.0; 2];
+                                p.state = PairState::Open;
+                                continue;
+                            }
+                        }
+                    }
+                };
+                let mut w = self.inv_mass[s];
+                for a in 0..nm as usize {
+                    w += weights[a] * weights[a] * self.inv_mass[masters[a] as usize];
+                }
+                if w == 0.0 {
+                    continue;
+                }
+                // current gap and relative displacement on the chosen configuration
+                let mut xbar = Vector3::zeros();
+                let mut um_n = Vector3::zeros();
+                for a in 0..nm as usize {
+                    let mi = masters[a] as usize;
+                    xbar += pos(model, conf, mi) * weights[a];
+                    um_n += disp(u, mi) * weights[a];
+                }
+                let gap = n.dot(&(xbar - xs));
+                if let Method::Penalty { kn, kt } = j.method {
+                    // explicit penalty at t[n]: tangential increment over the last step
+                    let mut um_p = Vector3::zeros();
+                    for a in 0..nm as usize {
+                        um_p += disp(u_prev, masters[a] as usize) * weights[a];
+                    }
+                    let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
+                    let area = j.tag.areas[i];
+                    let p = &mut rec.pairs[i];
+                    let (r_n, r_t, state) = if gap < 0.0 {
+                        let r_n = kn * area * (-gap);
+                        let mut rt = Vector2::new(p.r_t[0], p.r_t[1]) - kt * area * Vector2::new(dd.dot(&t1), dd.dot(&t2));
+                        let coh = if p.hist.intact { j.law.cohesion * area } else { 0.0 };
+                        let lim = j.law.mu * r_n + coh;
+                        let mut state = PairState::Stick;
+                        if rt.norm() > lim {
+                            rt *= lim / rt.norm();
+                            state = PairState::Slip;
+                            if !j.law.keep_cohesion {
+                                p.hist.intact = false;
+                            }
+                        }
+                        (r_n, rt, state)
+                    } else {
+                        if !j.law.keep_cohesion {
+                            p.hist.intact = false;
+                        }
+                        (0.0, Vector2::zeros(), PairState::Open)
+                    };
+                    let rvec = -n * r_n + t1 * r_t.x + t2 * r_t.y;
+                    p.d_t[0] += dd.dot(&t1);
+                    p.d_t[1] += dd.dot(&t2);
+                    p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
+                    p.gap = gap;
+                    p.face = face;
+                    p.r_n = r_n;
+                    p.r_t = [r_t.x, r_t.y];
+                    p.state = state;
+                    self.penalty.push((s as u32, masters, nm, weights, rvec));
+                    continue;
+                }
+                self.active.push(Active {
+                    joint: ji as u32,
+                    pair: i as u32,
+                    slave: s as u32,
+                    masters,
+                    nm,
+                    weights,
+                    dt2w: dt2 * w,
+                    r_n: 0.0,
+                    r_t: Vector2::zeros(),
+                    hist: pr.hist,
+                    state: PairState::Open,
+                    gap,
+                });
+                rec.pairs[i].face = face;
+            }
+        }
+
+        // penalty forces of step n act like external forces on the prediction
+        for &(s, masters, nm, weights, rvec) in &self.penalty {
+            let s = s as usize;
+            let im = self.inv_mass[s];
+            for c in 0..3 {
+                u_next[3 * s + c] += dt2 * rvec[c] * im;
+            }
+            for a in 0..nm as usize {
+                let mi = masters[a] as usize;
+                let imi = self.inv_mass[mi];
+                for c in 0..3 {
+                    u_next[3 * mi + c] -= dt2 * weights[a] * rvec[c] * imi;
+                }
+            }
+        }
+        for &(s, masters, nm, weights, rvec) in &self.penalty {
+            let s = s as usize;
+            let mut du = (disp(u_next, s) - disp(u_prev, s)) * 0.5;
+            for a in 0..nm as usize {
+                let mi = masters[a] as usize;
+                du -= (disp(u_next, mi) - disp(u_prev, mi)) * (0.5 * weights[a]);
+            }
+            penalty_work += rvec.dot(&du);
+        }
+
+        // ---------------------------------------------------------------- Gauss–Seidel
+        let mut sweeps = 0;
+        let mut converged = self.active.is_empty();
+        while !converged && sweeps < self.gs_max_sweeps {
+            sweeps += 1;
+            let mut max_dg: f64 = 0.0;
+            for k in 0..self.active.len() {
+                let a = self.active[k];
+                let j = &self.joints[a.joint as usize];
+                let i = a.pair as usize;
+                let [n, t1, t2] = j.frames[i];
+                let s = a.slave as usize;
+                let hist0 = history.joints[a.joint as usize].pairs[i].hist;
+                // current relative quantities with all forces applied so far
+                let mut xbar = Vector3::zeros();
+                let mut dum = Vector3::zeros();
+                for b in 0..a.nm as usize {
+                    let mi = a.masters[b] as usize;
+                    xbar += pos(model, u_next, mi) * a.weights[b];
+                    dum += (disp(u_next, mi) - disp(u, mi)) * a.weights[b];
+                }
+                let g_cur = n.dot(&(xbar - pos(model, u_next, s)));
+                let dd = (disp(u_next, s) - disp(u, s)) - dum;
+                // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
+                let g_trial = g_cur - a.dt2w * a.r_n;
+                let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
+                let resp = pair_force(&j.law, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i]);
+                let d_rn = resp.r_n - a.r_n;
+                let d_rt = resp.r_t - a.r_t;
+                if d_rn != 0.0 || d_rt.x != 0.0 || d_rt.y != 0.0 {
+                    let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
+                    let im = self.inv_mass[s];
+                    if im > 0.0 {
+                        for c in 0..3 {
+                            u_next[3 * s + c] += dt2 * dr[c] * im;
+                        }
+                    }
+                    for b in 0..a.nm as usize {
+                        let mi = a.masters[b] as usize;
+                        let imi = self.inv_mass[mi];
+                        if imi > 0.0 {
+                            for c in 0..3 {
+                                u_next[3 * mi + c] -= dt2 * a.weights[b] * dr[c] * imi;
+                            }
+                        }
+                    }
+                    max_dg = max_dg.max(a.dt2w * (d_rn.abs() + d_rt.norm()));
+                }
+                let e = &mut self.active[k];
+                e.r_n = resp.r_n;
+                e.r_t = resp.r_t;
+                e.hist = resp.hist;
+                e.state = resp.state;
+                e.gap = g_trial + a.dt2w * resp.r_n;
+            }
+            converged = max_dg <= self.gs_tolerance;
+        }
+
+        // ---------------------------------------------------------------- record
+        let mut work = penalty_work;
+        for rec in history.joints.iter_mut() {
+            rec.sweeps = sweeps;
+            rec.max_sweeps = rec.max_sweeps.max(sweeps);
+            if !converged {
+                rec.unconverged_steps += 1;
+            }
+        }
+        for a in &self.active {
+            let j = &self.joints[a.joint as usize];
+            let i = a.pair as usize;
+            let [n, t1, t2] = j.frames[i];
+            let s = a.slave as usize;
+            let p = &mut history.joints[a.joint as usize].pairs[i];
+            p.hist = a.hist;
+            p.state = a.state;
+            p.gap = a.gap;
+            p.r_n = a.r_n;
+            p.r_t = [a.r_t.x, a.r_t.y];
+            // accumulated tangential relative displacement (final positions)
+            let mut dum = Vector3::zeros();
+            let mut duc = Vector3::zeros();
+            for b in 0..a.nm as usize {
+                let mi = a.masters[b] as usize;
+                dum += (disp(u_next, mi) - disp(u, mi)) * a.weights[b];
+                duc += (disp(u_next, mi) - disp(u_prev, mi)) * (0.5 * a.weights[b]);
+            }
+            let dd = (disp(u_next, s) - disp(u, s)) - dum;
+            p.d_t[0] += dd.dot(&t1);
+            p.d_t[1] += dd.dot(&t2);
+            p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
+            let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
+            let du = (disp(u_next, s) - disp(u_prev, s)) * 0.5 - duc;
+            work += rvec.dot(&du);
+        }
+        Ok(CorrectionInfo { work, iterations: sweeps })
+    }
+}

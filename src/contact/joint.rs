@@ -1,0 +1,114 @@
+//! A joint ready for contact mechanics: the tagged interface, its law, method and options.
+//! Built once with the model, never mutated.
+
+use super::law::JointLaw;
+use crate::error::{Error, ModelError};
+use crate::interface::{tag_joint, Joint, JointSpec};
+use crate::mesh::Mesh;
+use crate::scene::JointSceneSpec;
+use nalgebra::Vector3;
+
+/// How pairs are formed and forced.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum Method {
+    /// Node-to-segment: inside-outside search along the slave normal, dynamic contact force.
+    Nts,
+    /// Node-to-node: each slave node paired with its initial nearest master node O (N = [1]).
+    Ntn,
+    /// Node-to-segment geometry with penalty springs instead of the dynamic contact force:
+    /// normal `kn` and tangential `kt` stiffness per unit area [Pa/m].
+    Penalty { kn: f64, kt: f64 },
+}
+
+/// What to do when a slave node's projection leaves its candidate set.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub enum OnExit {
+    /// Layer2 around the current centre, then a fresh nearest-master-node search from the
+    /// current relative position (the centre then follows the node).
+    Widen,
+    /// Count and report the node; it carries no force that step.
+    Report,
+}
+
+/// One joint of the model.
+#[derive(Clone, Debug)]
+pub struct ContactJoint {
+    pub tag: Joint,
+    pub law: JointLaw,
+    pub method: Method,
+    /// Candidate layer used first: 1 or 2.
+    pub layer: u8,
+    pub on_exit: OnExit,
+    /// Local frame (n, t1, t2) per slave node; n is the tagger's slave normal.
+    pub frames: Vec<[Vector3<f64>; 3]>,
+}
+
+/// A deterministic orthonormal completion (t1, t2) of a unit normal n.
+pub fn tangent_frame(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    // pick the axis least aligned with n
+    let a = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
+        Vector3::x()
+    } else if n.y.abs() <= n.z.abs() {
+        Vector3::y()
+    } else {
+        Vector3::z()
+    };
+    let t1 = (a - n * n.dot(&a)).normalize();
+    let t2 = n.cross(&t1);
+    (t1, t2)
+}
+
+impl ContactJoint {
+    /// Tag a scene joint on the mesh and resolve its law and options.
+    pub fn build(mesh: &Mesh, spec: &JointSceneSpec, model_size: f64) -> Result<ContactJoint, Error> {
+        let bad = |m: String| -> Error { ModelError::Invalid(format!("joint \"{}\": {m}", spec.name)).into() };
+        let mu = match (spec.mu, spec.phi) {
+            (Some(_), Some(_)) => return Err(bad("give `mu` or `phi`, not both".into())),
+            (Some(m), None) => m,
+            (None, Some(p)) => p.to_radians().tan(),
+            (None, None) => 0.6,
+        };
+        let law = JointLaw {
+            mu,
+            cohesion: spec.cohesion.unwrap_or(0.0),
+            tensile_strength: spec.tensile_strength.unwrap_or(0.0),
+            keep_cohesion: spec.keep_cohesion.unwrap_or(false),
+            tied: spec.tied.unwrap_or(false),
+        };
+        law.validate().map_err(|e| bad(e.to_string()))?;
+        let method = match spec.method.as_deref().unwrap_or("nts") {
+            "nts" => Method::Nts,
+            "ntn" => Method::Ntn,
+            "penalty" => {
+                let kn = spec.penalty_stiffness.ok_or_else(|| bad("method \"penalty\" needs `penalty_stiffness` [Pa/m]".into()))?;
+                if !(kn > 0.0 && kn.is_finite()) {
+                    return Err(bad(format!("penalty_stiffness = {kn} must be positive [Pa/m]")));
+                }
+                Method::Penalty { kn, kt: kn }
+            }
+            other => return Err(bad(format!("method \"{other}\" is not one of \"nts\", \"ntn\", \"penalty\""))),
+        };
+        let layer = spec.layer.unwrap_or(1);
+        if layer != 1 && layer != 2 {
+            return Err(bad(format!("layer = {layer} must be 1 or 2")));
+        }
+        let on_exit = match spec.on_exit.as_deref().unwrap_or("widen") {
+            "widen" => OnExit::Widen,
+            "report" => OnExit::Report,
+            other => return Err(bad(format!("on_exit \"{other}\" is not \"widen\" or \"report\""))),
+        };
+        let tol = spec.tolerance.unwrap_or(1e-6 * model_size);
+        let js = JointSpec { name: spec.name.clone(), master: spec.master.clone(), slave: spec.slave.clone(), auto: spec.auto };
+        let tag = tag_joint(mesh, &js, tol)?;
+        let frames = tag
+            .normals
+            .iter()
+            .map(|n| {
+                let n = Vector3::from(*n);
+                let (t1, t2) = tangent_frame(&n);
+                [n, t1, t2]
+            })
+            .collect();
+        Ok(ContactJoint { tag, law, method, layer, on_exit, frames })
+    }
+}
