@@ -55,6 +55,8 @@ pub struct SearchEvents {
     pub widened_layer2: u64,
     /// Fresh nearest-node searches (the centre moved).
     pub fresh_searches: u64,
+    /// Times the centre of a candidate set moved to follow its slave node (`widen` only).
+    pub recentred: u64,
     /// Node-steps with no master face found (force-free that step).
     pub lost: u64,
     /// Quad projections that did not converge (the face was skipped).
@@ -317,7 +319,8 @@ impl Correction for ContactSolver<'_> {
                         }
                         match found {
                             Some((f, p)) => {
-                                // keep the candidate set centred on the node the slave is nearest to
+                                // `widen`: keep the candidate set centred on the node the slave is
+                                // nearest to (`report` keeps the initial set, by definition)
                                 let local = j.tag.master.faces[f].local_nodes();
                                 let (mut best, mut wmax) = (local[0], f64::MIN);
                                 for (a, &l) in local.iter().enumerate() {
@@ -326,7 +329,10 @@ impl Correction for ContactSolver<'_> {
                                         best = l;
                                     }
                                 }
-                                rec.pairs[i].center = best;
+                                if j.on_exit == OnExit::Widen && rec.pairs[i].center != best {
+                                    rec.pairs[i].center = best;
+                                    rec.events.recentred += 1;
+                                }
                                 let nodes = j.tag.master.faces[f].nodes();
                                 let mut ms = [0u32; 4];
                                 for (a, &nd) in nodes.iter().enumerate() {

@@ -43,3 +43,27 @@ pub fn simulate(model: &Model, scene: &Scene, courant: f64, steps: usize, mut ob
     }
     (dt, state)
 }
+
+/// As [`simulate`], with the model's joints in contact (dynamic contact force) and optional
+/// gravity relaxation first. Returns (dt, final state).
+pub fn simulate_contact(model: &Model, scene: &Scene, courant: f64, steps: usize, relax: bool, mut observe: impl FnMut(f64, &State)) -> (f64, State) {
+    use jointquake::contact::force::ContactSolver;
+    use jointquake::dynamics::{relax_gravity, Correction};
+    let (loads, _) = Loads::build(model, scene).expect("loads");
+    let dt = courant * model.stable_dt();
+    let mut solver = ExplicitSolver::new(model, dt, scene.time.energy_tolerance);
+    let mut contact = ContactSolver::new(model, &model.joints);
+    let mut state = State::at_rest(model);
+    if relax {
+        let eq = relax_gravity(model, &loads, &mut solver, &mut state, Some(&mut contact as &mut dyn Correction), 1e-6, 200_000).expect("relaxation");
+        assert!(eq.converged, "gravity relaxation: {eq:?}");
+        state.step = 0;
+        state.t = 0.0;
+    }
+    solver.start_energy(model, &mut state);
+    for _ in 0..steps {
+        solver.step(model, &loads, &mut state, Stage::Dynamic, Some(&mut contact as &mut dyn Correction)).expect("step");
+        observe(state.t, &state);
+    }
+    (dt, state)
+}

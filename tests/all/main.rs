@@ -3,6 +3,7 @@
 //! Physics tests state their reference and tolerance in a comment.
 
 mod common;
+mod contact;
 mod dynamics;
 mod mesh;
 mod rigid;
