@@ -352,6 +352,11 @@ pub struct JointSceneSpec {
     /// Tied (bonded, never opens or slides). Default false.
     #[serde(default)]
     pub tied: Option<bool>,
+    /// Inside-test tolerance as a fraction of the master face size [-]. Default 0.01: a slave node
+    /// that far outside the master surface's boundary (line of intersection, crest) still contacts
+    /// the edge face, so round-off and elastic deformation do not drop the joint's boundary nodes.
+    #[serde(default)]
+    pub edge_tolerance: Option<f64>,
     /// Penalty stiffness per unit area [Pa/m] for method "penalty".
     #[serde(default)]
     pub penalty_stiffness: Option<f64>,

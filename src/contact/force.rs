@@ -22,7 +22,7 @@
 
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force, PairHistory, PairState};
-use super::query::{select_projection, INSIDE_TOL_DEFAULT};
+use super::query::select_projection;
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
 use crate::model::Model;
@@ -221,14 +221,14 @@ fn project_on(
         }
         pts.push((f as usize, x, nodes.len()));
     }
-    match select_projection(xs, n, pts.iter().map(|(f, x, k)| (*f, &x[..*k])), INSIDE_TOL_DEFAULT) {
+    match select_projection(xs, n, pts.iter().map(|(f, x, k)| (*f, &x[..*k])), j.edge_tolerance) {
         Ok(p) => p,
         Err(_) => {
             // a face whose quad solve failed: retry without the failing faces one by one
             *failures += 1;
             let mut best: Option<(usize, super::query::Projection)> = None;
             for (f, x, k) in &pts {
-                if let Ok(Some((ff, p))) = select_projection(xs, n, std::iter::once((*f, &x[..*k])), INSIDE_TOL_DEFAULT) {
+                if let Ok(Some((ff, p))) = select_projection(xs, n, std::iter::once((*f, &x[..*k])), j.edge_tolerance) {
                     best = match best {
                         Some((bf, bp)) if bp.t.abs() <= p.t.abs() => Some((bf, bp)),
                         _ => Some((ff, p)),

@@ -39,6 +39,8 @@ pub struct ContactJoint {
     /// Candidate layer used first: 1 or 2.
     pub layer: u8,
     pub on_exit: OnExit,
+    /// Inside-test tolerance, fraction of the face size (see the scene field `edge_tolerance`).
+    pub edge_tolerance: f64,
     /// Local frame (n, t1, t2) per slave node; n is the tagger's slave normal.
     pub frames: Vec<[Vector3<f64>; 3]>,
 }
@@ -97,6 +99,10 @@ impl ContactJoint {
             "report" => OnExit::Report,
             other => return Err(bad(format!("on_exit \"{other}\" is not \"widen\" or \"report\""))),
         };
+        let edge_tolerance = spec.edge_tolerance.unwrap_or(0.01);
+        if !(edge_tolerance > 0.0 && edge_tolerance < 0.5) {
+            return Err(bad(format!("edge_tolerance = {edge_tolerance} must be in (0, 0.5) (fraction of the face size)")));
+        }
         let tol = spec.tolerance.unwrap_or(1e-6 * model_size);
         let js = JointSpec { name: spec.name.clone(), master: spec.master.clone(), slave: spec.slave.clone(), auto: spec.auto };
         let tag = tag_joint(mesh, &js, tol)?;
@@ -109,6 +115,6 @@ impl ContactJoint {
                 [n, t1, t2]
             })
             .collect();
-        Ok(ContactJoint { tag, law, method, layer, on_exit, frames })
+        Ok(ContactJoint { tag, law, method, layer, on_exit, edge_tolerance, frames })
     }
 }
