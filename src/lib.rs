@@ -33,5 +33,6 @@ pub mod output;
 pub mod pipeline;
 pub mod rigid;
 pub mod scene;
+pub mod study;
 
 pub use error::{Error, Result};

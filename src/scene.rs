@@ -112,6 +112,10 @@ pub struct Gravity {
     /// Unit direction. Default [0, 0, -1] (z up).
     #[serde(default = "down")]
     pub direction: [f64; 3],
+    /// Volume groups that carry their weight. Default: all. E.g. `["block:wedge"]` makes the
+    /// rock a weightless support, the assumption of limit equilibrium.
+    #[serde(default)]
+    pub groups: Option<Vec<String>>,
 }
 
 fn down() -> [f64; 3] {

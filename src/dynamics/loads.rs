@@ -33,6 +33,8 @@ pub struct ForcePattern {
 pub struct Loads {
     /// Gravity acceleration vector [m/s²].
     pub gravity: Option<[f64; 3]>,
+    /// Nodes that carry weight when gravity is restricted to some groups (None: all nodes).
+    pub gravity_nodes: Option<Vec<bool>>,
     pub base: Vec<BaseMotion>,
     pub patterns: Vec<ForcePattern>,
 }
@@ -45,6 +47,16 @@ impl Loads {
             let d = Vector3::from(g.direction).normalize() * g.g;
             [d[0], d[1], d[2]]
         });
+        let mut gravity_nodes = None;
+        if let Some(groups) = scene.loads.gravity.as_ref().and_then(|g| g.groups.as_ref()) {
+            let mut mask = vec![false; model.n_nodes()];
+            for g in groups {
+                for n in model.mesh.group_nodes(&model.mesh.group_of_dim(g, 3)?.name)? {
+                    mask[n] = true;
+                }
+            }
+            gravity_nodes = Some(mask);
+        }
         let mut base = Vec::new();
         for b in &scene.loads.base {
             let record = Record::read(&b.record, scene.g)?;
@@ -92,7 +104,7 @@ impl Loads {
             notes.push(format!("nodal force at ({:?}) snapped to node {} at distance {:.3e} m", nf.point, model.mesh.node_tags[node], dist));
             patterns.push(ForcePattern { forces: vec![(node, nf.force)], ramp: nf.ramp });
         }
-        Ok((Loads { gravity, base, patterns }, notes))
+        Ok((Loads { gravity, gravity_nodes, base, patterns }, notes))
     }
 
     /// Ground acceleration vector a_g(t) [m/s²].
@@ -115,22 +127,16 @@ impl Loads {
     /// f = F_ext(t) (overwritten): m (g − a_g(t)) on every node plus the force patterns.
     /// `with_gravity`/`with_dynamic` select the parts (gravity alone during relaxation).
     pub fn external_force_into(&self, model: &Model, t: f64, with_gravity: bool, with_dynamic: bool, f: &mut [f64]) {
-        let mut acc = [0.0; 3];
-        if with_gravity {
-            if let Some(g) = self.gravity {
-                acc = g;
-            }
-        }
-        if with_dynamic {
-            let ag = self.ground_acceleration(t);
-            for i in 0..3 {
-                acc[i] -= ag[i];
-            }
-        }
+        let g = if with_gravity { self.gravity.unwrap_or([0.0; 3]) } else { [0.0; 3] };
+        let ag = if with_dynamic { self.ground_acceleration(t) } else { [0.0; 3] };
         for (n, &m) in model.mass.iter().enumerate() {
-            f[3 * n] = m * acc[0];
-            f[3 * n + 1] = m * acc[1];
-            f[3 * n + 2] = m * acc[2];
+            let w = match &self.gravity_nodes {
+                Some(mask) if !mask[n] => 0.0,
+                _ => 1.0,
+            };
+            f[3 * n] = m * (w * g[0] - ag[0]);
+            f[3 * n + 1] = m * (w * g[1] - ag[1]);
+            f[3 * n + 2] = m * (w * g[2] - ag[2]);
         }
         if with_dynamic {
             for p in &self.patterns {

@@ -106,8 +106,9 @@ pub struct StepInfo {
 /// Which loads a step applies.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Stage {
-    /// Gravity only, mass-proportional damping α [1/s] only (dynamic relaxation).
-    Relaxation(f64),
+    /// Gravity only, scaled by the second value (load ramp), mass-proportional damping α [1/s]
+    /// only (dynamic relaxation).
+    Relaxation(f64, f64),
     /// Everything: gravity, base motion, force patterns, Rayleigh damping.
     Dynamic,
 }
@@ -167,7 +168,12 @@ impl ExplicitSolver {
         loads.external_force_into(model, state.t, true, dynamic, &mut self.f_ext);
         let (alpha, beta) = match stage {
             Stage::Dynamic => (model.alpha, model.beta),
-            Stage::Relaxation(a) => (a, 0.0),
+            Stage::Relaxation(a, scale) => {
+                if scale != 1.0 {
+                    self.f_ext.iter_mut().for_each(|f| *f *= scale);
+                }
+                (a, 0.0)
+            }
         };
         if beta > 0.0 {
             let c = beta / dt;
@@ -335,11 +341,18 @@ pub struct EquilibriumInfo {
     pub converged: bool,
 }
 
+/// Steps over which relaxation ramps gravity from 0 to its full value. Default 1000: a sudden
+/// load overshoots dynamically (up to twice the static response) and would make joints slip
+/// irreversibly before the static state is reached; a ramp over several lowest periods of
+/// typical models keeps the loading quasi-static.
+pub const RELAXATION_RAMP_STEPS: usize = 1000;
+
 /// Dynamic relaxation with adaptive viscous damping (Underwood): undamped mass, damping
 /// C = αM with α = 2 ω_min, ω_min² estimated every step by the Rayleigh quotient
 /// uᵀKu / uᵀMu of the current displacement (dominated by the lowest mode during relaxation),
-/// so the lowest mode is critically damped. Stops when the out-of-balance force ‖M a‖ (gravity,
-/// elastic and contact forces together) falls below `tol` × ‖F_gravity‖.
+/// so the lowest mode is critically damped. Gravity is ramped in over
+/// [`RELAXATION_RAMP_STEPS`] steps. Stops when the out-of-balance force ‖M a‖ (gravity,
+/// elastic and contact forces together) falls below `tol` × ‖F_gravity‖ after the ramp.
 pub fn relax_gravity<'c>(
     model: &Model,
     loads: &Loads,
@@ -359,7 +372,8 @@ pub fn relax_gravity<'c>(
     let mut residual = f64::INFINITY;
     let mut alpha = 0.0;
     for k in 0..max_steps {
-        solver.step(model, loads, state, Stage::Relaxation(alpha), correction.as_deref_mut())?;
+        let scale = ((k + 1) as f64 / RELAXATION_RAMP_STEPS as f64).min(1.0);
+        solver.step(model, loads, state, Stage::Relaxation(alpha, scale), correction.as_deref_mut())?;
         // after the step: u_nm1 = u[n−1], u_prev = u[n], u = u[n+1]; f_int = K u[n].
         // Out-of-balance force F − K u[n] + R[n] = M a[n] + α M v_b (contact forces included).
         let mut r2 = 0.0;
@@ -370,7 +384,7 @@ pub fn relax_gravity<'c>(
                 let m = model.mass[i / 3];
                 let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
                 let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
-                let r = m * (a + alpha * vb);
+                let r = m * (a + alpha * vb) / scale;
                 r2 += r * r;
                 ukb += state.u_prev[i] * f_int[i];
                 umu += m * state.u_prev[i] * state.u_prev[i];
@@ -381,7 +395,7 @@ pub fn relax_gravity<'c>(
             // α = 2 ω_min, kept below the stability bound α dt < 1
             alpha = (2.0 * (ukb / umu).sqrt()).min(0.5 / dt);
         }
-        if residual < tol && k > 2 {
+        if residual < tol && k + 1 >= RELAXATION_RAMP_STEPS {
             state.u_prev.copy_from_slice(&state.u);
             return Ok(EquilibriumInfo { steps: k + 1, residual, converged: true });
         }

@@ -1,0 +1,138 @@
+//! FEM strength reduction (SSR): the factor F by which c and tan φ of every joint can be
+//! divided before the model fails under gravity.
+//!
+//! Each trial F builds the model with c/F and tan φ/F on every joint (cohesion kept after slip
+//! or opening: perfectly plastic Mohr-Coulomb, the assumption of limit equilibrium) and runs gravity
+//! relaxation with contact ([`crate::dynamics::relax_gravity`]). **Failure criterion**: the
+//! relaxation does not reach its residual tolerance within `max_steps`, or any slave node of
+//! the joints has slipped more than `slip_limit` (the block is sliding, not settling). F is
+//! bisected between a stable and a failed value until the bracket is narrower than `tolerance`.
+
+use crate::contact::force::ContactSolver;
+use crate::dynamics::{loads::Loads, relax_gravity, Correction, ExplicitSolver, State};
+use crate::error::{Error, ModelError};
+use crate::mesh::Mesh;
+use crate::model::Model;
+use crate::scene::Scene;
+use serde::Serialize;
+
+/// Settings of a strength-reduction search.
+#[derive(Clone, Debug, Serialize)]
+pub struct SsrOptions {
+    /// Initial bracket [F_low, F_high]: F_low must be stable, F_high must fail. Default [0.5, 4].
+    pub bracket: [f64; 2],
+    /// Stop when F_high − F_low < tolerance. Default 0.005.
+    pub tolerance: f64,
+    /// Relaxation step budget per trial. Default 40 000.
+    pub max_steps: usize,
+    /// Relative residual of the relaxation. Default 1e-5.
+    pub residual: f64,
+    /// Slip [m] above which a trial counts as failed. Default 0.05 m.
+    pub slip_limit: f64,
+    /// Node whose displacement is recorded per trial (e.g. P1), if any.
+    pub monitor: Option<[f64; 3]>,
+}
+
+impl Default for SsrOptions {
+    fn default() -> Self {
+        SsrOptions { bracket: [0.5, 4.0], tolerance: 0.005, max_steps: 40_000, residual: 1e-5, slip_limit: 0.05, monitor: None }
+    }
+}
+
+/// One trial of the search.
+#[derive(Clone, Debug, Serialize)]
+pub struct SsrTrial {
+    pub factor: f64,
+    pub failed: bool,
+    pub converged: bool,
+    pub steps: usize,
+    pub residual: f64,
+    /// Largest slip of any slave node [m].
+    pub max_slip: f64,
+    /// |u| of the monitored node [m].
+    pub monitor_displacement: f64,
+}
+
+/// Result: the bracket and every trial (in the order run).
+#[derive(Clone, Debug, Serialize)]
+pub struct SsrResult {
+    pub factor: f64,
+    pub bracket: [f64; 2],
+    pub trials: Vec<SsrTrial>,
+    pub criterion: String,
+}
+
+/// Run one trial at factor `f`.
+pub fn ssr_trial(mesh: &Mesh, scene: &Scene, f: f64, opts: &SsrOptions) -> Result<SsrTrial, Error> {
+    let mut sc = scene.clone();
+    for j in &mut sc.joints {
+        let mu = match (j.mu, j.phi) {
+            (Some(m), _) => m,
+            (None, Some(p)) => p.to_radians().tan(),
+            (None, None) => 0.6,
+        };
+        j.mu = Some(mu / f);
+        j.phi = None;
+        j.cohesion = Some(j.cohesion.unwrap_or(0.0) / f);
+        // strength reduction is defined for perfectly plastic Mohr-Coulomb (as limit equilibrium):
+        // cohesion stays mobilised after local slip or opening
+        j.keep_cohesion = Some(true);
+    }
+    let model = Model::build(mesh.clone(), &sc)?;
+    let (loads, _) = Loads::build(&model, &sc)?;
+    if loads.gravity.is_none() {
+        return Err(ModelError::Invalid("strength reduction needs gravity in the scene's loads".into()).into());
+    }
+    let dt = sc.time.courant.unwrap_or(0.9) * model.stable_dt();
+    let mut solver = ExplicitSolver::new(&model, dt, sc.time.energy_tolerance);
+    let mut contact = ContactSolver::new(&model, &model.joints);
+    let mut state = State::at_rest(&model);
+    let eq = relax_gravity(&model, &loads, &mut solver, &mut state, Some(&mut contact as &mut dyn Correction), opts.residual, opts.max_steps)?;
+    let max_slip = state.contact.joints.iter().flat_map(|j| j.pairs.iter()).map(|p| p.slip).fold(0.0, f64::max);
+    let monitor_displacement = match opts.monitor {
+        Some(p) => {
+            let (n, _) = model.mesh.nearest_node(p).ok_or_else(|| ModelError::Invalid("empty mesh".into()))?;
+            (state.u[3 * n].powi(2) + state.u[3 * n + 1].powi(2) + state.u[3 * n + 2].powi(2)).sqrt()
+        }
+        None => 0.0,
+    };
+    let failed = !eq.converged || max_slip > opts.slip_limit;
+    Ok(SsrTrial { factor: f, failed, converged: eq.converged, steps: eq.steps, residual: eq.residual, max_slip, monitor_displacement })
+}
+
+/// Bisection on F (see the module doc for the failure criterion).
+pub fn strength_reduction(mesh: &Mesh, scene: &Scene, opts: &SsrOptions) -> Result<SsrResult, Error> {
+    let mut trials = Vec::new();
+    let [mut lo, mut hi] = opts.bracket;
+    let t_lo = ssr_trial(mesh, scene, lo, opts)?;
+    let lo_failed = t_lo.failed;
+    trials.push(t_lo);
+    if lo_failed {
+        return Err(ModelError::Invalid(format!("strength reduction: the model already fails at F = {lo} (lower the bracket)")).into());
+    }
+    let t_hi = ssr_trial(mesh, scene, hi, opts)?;
+    let hi_failed = t_hi.failed;
+    trials.push(t_hi);
+    if !hi_failed {
+        return Err(ModelError::Invalid(format!("strength reduction: the model is still stable at F = {hi} (raise the bracket)")).into());
+    }
+    while hi - lo > opts.tolerance {
+        let mid = 0.5 * (lo + hi);
+        let t = ssr_trial(mesh, scene, mid, opts)?;
+        if t.failed {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+        trials.push(t);
+    }
+    Ok(SsrResult {
+        factor: 0.5 * (lo + hi),
+        bracket: [lo, hi],
+        trials,
+        criterion: format!(
+            "failed = relaxation not converged to {:.0e} within {} steps, or slip > {} m",
+            opts.residual, opts.max_steps, opts.slip_limit
+        ),
+    })
+}
