@@ -26,12 +26,14 @@ pub enum Error {
     Interface(#[from] InterfaceError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    Rigid(#[from] crate::rigid::RigidError),
 }
 
 /// Reading a `.msh` file or looking up its parts.
 #[derive(Debug, Error)]
 pub enum MeshError {
-    #[error("cannot read mesh file {path}: {source}")]
+    #[error("cannot read mesh file {path}: {source}. Check the path (`geometry.msh` in a scene is relative to the scene file).")]
     Io { path: PathBuf, source: std::io::Error },
     #[error("{path} is not a valid MSH 4.1 file: {reason}. Re-export it from Gmsh with `-format msh41` (ASCII or binary).")]
     Malformed { path: PathBuf, reason: String },
