@@ -481,7 +481,8 @@ impl TagSummary {
     pub fn to_text(&self) -> String {
         use std::fmt::Write as _;
         let mut s = String::new();
-        let _ = writeln!(s, "scene {}: {} joints tagged on {} ({} nodes, model size {:.4} m)", self.scene, self.joints.len(), self.mesh.display(), self.nodes, self.model_size);
+        let plural = if self.joints.len() == 1 { "" } else { "s" };
+        let _ = writeln!(s, "scene {}: {} joint{plural} tagged on {} ({} nodes, model size {:.4} m)", self.scene, self.joints.len(), self.mesh.display(), self.nodes, self.model_size);
         for j in &self.joints {
             let _ = writeln!(s, "joint {}", j.name);
             let choice = match (j.auto, j.swapped) {

@@ -253,3 +253,11 @@ fn duplicate_joint_file_names_are_refused() {
     let msg = tag_error("tag_duplicate_names", &s);
     assert_mentions(&msg, &["joint \"J_1\"", "J_1.vtu", "\"J/1\"", "distinct names"]);
 }
+
+#[test]
+fn material_on_a_face_group_says_a_volume_group_is_needed() {
+    let mut s = column_scene();
+    s["materials"][0]["group"] = json!("bc:base");
+    let msg = run_error("material_on_faces", &s);
+    assert_mentions(&msg, &["\"bc:base\" has dimension 2", "a volume group (tet4/hex8 elements) of dimension 3 is needed", "\"block:column\" (dim 3)"]);
+}
