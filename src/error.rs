@@ -26,12 +26,14 @@ pub enum Error {
     Interface(#[from] InterfaceError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    Rigid(#[from] crate::rigid::RigidError),
 }
 
 /// Reading a `.msh` file or looking up its parts.
 #[derive(Debug, Error)]
 pub enum MeshError {
-    #[error("cannot read mesh file {path}: {source}")]
+    #[error("cannot read mesh file {path}: {source}. Check the path (`geometry.msh` in a scene is relative to the scene file).")]
     Io { path: PathBuf, source: std::io::Error },
     #[error("{path} is not a valid MSH 4.1 file: {reason}. Re-export it from Gmsh with `-format msh41` (ASCII or binary).")]
     Malformed { path: PathBuf, reason: String },
@@ -39,7 +41,7 @@ pub enum MeshError {
     UnsupportedElement { path: PathBuf, element: u64, kind: String },
     #[error("{path}: element {element} refers to node {node}, which is not in the $Nodes section")]
     MissingNode { path: PathBuf, element: u64, node: u64 },
-    #[error("unknown physical group \"{name}\"{}. Groups in the mesh: {}", dim.map(|d| format!(" of dimension {d}")).unwrap_or_default(), available.join(", "))]
+    #[error("{}", unknown_group_text(name, *dim, available))]
     UnknownGroup { name: String, dim: Option<usize>, available: Vec<String> },
     #[error("{path}: physical group \"{group}\": element {element} is inverted (Jacobian {jacobian:.3e} at a corner). Fix the node order or the geometry orientation in the .geo (e.g. `ReverseMesh`).")]
     InvertedElement { path: PathBuf, group: String, element: u64, jacobian: f64 },
@@ -121,6 +123,30 @@ pub enum OutputError {
 impl OutputError {
     pub fn write(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
         OutputError::Write { path: path.into(), message: e.to_string() }
+    }
+}
+
+/// Message of [`MeshError::UnknownGroup`]: a name that is not in the mesh, or a name that is
+/// there with another dimension (then the message says which dimension is needed and why).
+fn unknown_group_text(name: &str, dim: Option<usize>, available: &[String]) -> String {
+    let list = available.join(", ");
+    let prefix = format!("\"{name}\" (dim ");
+    let other_dims: Vec<&str> = available.iter().filter_map(|a| a.strip_prefix(&prefix)).map(|r| r.trim_end_matches(')')).collect();
+    match dim {
+        Some(d) if !other_dims.is_empty() => {
+            let kind = match d {
+                3 => "a volume group (tet4/hex8 elements)",
+                2 => "a face group (tri3/quad4 elements)",
+                1 => "a curve group",
+                _ => "a point group",
+            };
+            format!(
+                "physical group \"{name}\" has dimension {}, but {kind} of dimension {d} is needed here. Groups in the mesh: {list}",
+                other_dims.join(" and ")
+            )
+        }
+        Some(d) => format!("unknown physical group \"{name}\" of dimension {d}. Groups in the mesh: {list}"),
+        None => format!("unknown physical group \"{name}\". Groups in the mesh: {list}"),
     }
 }
 

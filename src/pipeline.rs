@@ -355,3 +355,205 @@ impl RunSummary {
         s
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// `jointquake tag`: tag the joints of a scene and write them for inspection (no time stepping).
+
+/// Default joint tolerance as a fraction of the mesh bounding-box diagonal, used when a joint
+/// gives no `tolerance`. 1e-6: far above the round-off of coordinates written by Gmsh (≈1e-16
+/// relative) and far below any gap a real model would want closed silently.
+pub const DEFAULT_JOINT_TOLERANCE_RELATIVE: f64 = 1e-6;
+
+/// What `tag` found for one joint (lengths in m, areas in m²).
+#[derive(Clone, Debug, Serialize)]
+pub struct JointTagSummary {
+    pub name: String,
+    /// Group that became the slave / master (after `auto`).
+    pub slave_group: String,
+    pub master_group: String,
+    /// `auto` as written in the scene, and whether it exchanged the named roles.
+    pub auto: bool,
+    pub swapped: bool,
+    /// Tolerance used [m] and where it came from ("scene" or "default").
+    pub tolerance: f64,
+    pub tolerance_source: String,
+    pub slave_nodes: usize,
+    pub slave_faces: usize,
+    pub master_nodes: usize,
+    pub master_faces: usize,
+    pub slave_area: f64,
+    pub master_area: f64,
+    /// Mean number of master faces in Layer1 / Layer2 per slave node.
+    pub layer1_mean: f64,
+    pub layer2_mean: f64,
+    /// Largest slave-node-to-O distance [m] (the NTN error) and the Gmsh tag of that slave node.
+    pub ntn_max_distance: f64,
+    pub ntn_max_node_tag: u64,
+    /// Slave nodes whose O coincides with them (within 1e-9 × joint size).
+    pub ntn_conforming: usize,
+    /// Largest slave-node-to-master-surface distance [m].
+    pub max_surface_distance: f64,
+    /// The joint's VTU file.
+    pub vtu: PathBuf,
+}
+
+/// What `tag` reports (also written as `<out>/tagging/summary.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct TagSummary {
+    pub scene: String,
+    pub mesh: PathBuf,
+    pub nodes: usize,
+    /// Mesh bounding-box diagonal [m] (scale of the default tolerance).
+    pub model_size: f64,
+    pub joints: Vec<JointTagSummary>,
+    /// `joints.json` (all joints, layout in docs/tagger.md).
+    pub json: PathBuf,
+    pub out_dir: PathBuf,
+    pub wall_time: f64,
+}
+
+/// A joint name made safe for a file name: characters other than letters, digits, `-`, `_` and
+/// `.` become `_`.
+fn joint_file_stem(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' }).collect()
+}
+
+/// Tag every joint of a scene: load the scene, mesh it, tag `scene.joints` in order (tolerance:
+/// the joint's `tolerance`, else [`DEFAULT_JOINT_TOLERANCE_RELATIVE`] × the mesh bounding-box
+/// diagonal), and write `<out>/tagging/joints.json`, one `<out>/tagging/<joint>.vtu` per joint and
+/// `<out>/tagging/summary.json`. `<out>` is `opts.out_dir`, else the scene's output directory.
+pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
+    use crate::error::InterfaceError;
+    use crate::interface::{tag_joint, write_joint_json, write_joint_vtu, JointSpec};
+    let t_all = Instant::now();
+    let scene = Scene::load(scene_path)?;
+    if scene.joints.is_empty() {
+        return Err(crate::error::SceneError::Invalid {
+            path: scene_path.to_path_buf(),
+            message: "no joints to tag: add a `joints` list with `name`, `master` and `slave` face groups (see docs/scenes.md)".into(),
+        }
+        .into());
+    }
+    let mut stems: Vec<(String, &str)> = Vec::new();
+    for j in &scene.joints {
+        if j.name.is_empty() {
+            return Err(crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message: "joints: a joint has an empty `name`".into() }.into());
+        }
+        let stem = joint_file_stem(&j.name);
+        if let Some((_, other)) = stems.iter().find(|(s, _)| *s == stem) {
+            return Err(InterfaceError::Invalid {
+                joint: j.name.clone(),
+                message: format!("its output file name \"{stem}.vtu\" is also that of joint \"{other}\"; give the joints distinct names"),
+            }
+            .into());
+        }
+        stems.push((stem, &j.name));
+    }
+    let mesh = load_mesh(&scene, opts)?;
+    let model_size = mesh_diagonal(&mesh);
+    let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
+    let dir = out_dir.join("tagging");
+    std::fs::create_dir_all(&dir).map_err(|e| crate::error::OutputError::write(&dir, e))?;
+
+    let mut joints = Vec::with_capacity(scene.joints.len());
+    let mut rows = Vec::with_capacity(scene.joints.len());
+    for (j, (stem, _)) in scene.joints.iter().zip(&stems) {
+        let spec = JointSpec { name: j.name.clone(), master: j.master.clone(), slave: j.slave.clone(), auto: j.auto };
+        let (tolerance, source) = match j.tolerance {
+            Some(t) => (t, "scene"),
+            None => (DEFAULT_JOINT_TOLERANCE_RELATIVE * model_size, "default"),
+        };
+        let joint = tag_joint(&mesh, &spec, tolerance)?;
+        let vtu = dir.join(format!("{stem}.vtu"));
+        write_joint_vtu(&vtu, &mesh, &joint)?;
+        let n = joint.n_slave().max(1) as f64;
+        rows.push(JointTagSummary {
+            name: joint.name.clone(),
+            slave_group: joint.slave.group.clone(),
+            master_group: joint.master.group.clone(),
+            auto: j.auto,
+            swapped: joint.swapped,
+            tolerance,
+            tolerance_source: source.to_string(),
+            slave_nodes: joint.n_slave(),
+            slave_faces: joint.slave.faces.len(),
+            master_nodes: joint.master.nodes.len(),
+            master_faces: joint.master.faces.len(),
+            slave_area: joint.slave.area,
+            master_area: joint.master.area,
+            layer1_mean: joint.layer1.items.len() as f64 / n,
+            layer2_mean: joint.layer2.items.len() as f64 / n,
+            ntn_max_distance: joint.ntn_max_distance,
+            ntn_max_node_tag: joint.slave.nodes.get(joint.ntn_max_slave).map(|&m| mesh.node_tags[m]).unwrap_or(0),
+            ntn_conforming: joint.ntn_conforming_count(),
+            max_surface_distance: joint.surface_distance.iter().copied().fold(0.0, f64::max),
+            vtu,
+        });
+        joints.push(joint);
+    }
+    let json = dir.join("joints.json");
+    write_joint_json(&json, &mesh, &joints)?;
+    let summary = TagSummary {
+        scene: scene.name().to_string(),
+        mesh: mesh.source.clone(),
+        nodes: mesh.nodes.len(),
+        model_size,
+        joints: rows,
+        json,
+        out_dir: dir.clone(),
+        wall_time: t_all.elapsed().as_secs_f64(),
+    };
+    let sp = dir.join("summary.json");
+    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("tag summary serialises"))
+        .map_err(|e| crate::error::OutputError::write(&sp, e))?;
+    Ok(summary)
+}
+
+/// Diagonal of the bounding box of all mesh nodes [m] (0 for an empty mesh).
+fn mesh_diagonal(mesh: &Mesh) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &mesh.nodes {
+        for d in 0..3 {
+            lo[d] = lo[d].min(p[d]);
+            hi[d] = hi[d].max(p[d]);
+        }
+    }
+    if mesh.nodes.is_empty() {
+        return 0.0;
+    }
+    ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+}
+
+impl TagSummary {
+    /// A per-joint table for the terminal.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write as _;
+        let mut s = String::new();
+        let plural = if self.joints.len() == 1 { "" } else { "s" };
+        let _ = writeln!(s, "scene {}: {} joint{plural} tagged on {} ({} nodes, model size {:.4} m)", self.scene, self.joints.len(), self.mesh.display(), self.nodes, self.model_size);
+        for j in &self.joints {
+            let _ = writeln!(s, "joint {}", j.name);
+            let choice = match (j.auto, j.swapped) {
+                (false, _) => "as named (auto off)".to_string(),
+                (true, false) => "auto: kept the named roles (the named slave is the finer side, or a tie)".to_string(),
+                (true, true) => "auto: swapped the named roles (the named master is the finer side)".to_string(),
+            };
+            let _ = writeln!(s, "  slave           \"{}\": {} nodes, {} faces, {:.4} m²", j.slave_group, j.slave_nodes, j.slave_faces, j.slave_area);
+            let _ = writeln!(s, "  master          \"{}\": {} nodes, {} faces, {:.4} m²", j.master_group, j.master_nodes, j.master_faces, j.master_area);
+            let _ = writeln!(s, "  roles           {choice}");
+            let _ = writeln!(s, "  tolerance       {:.3e} m ({})", j.tolerance, if j.tolerance_source == "scene" { "from the scene" } else { "default: 1e-6 × model size" });
+            let _ = writeln!(s, "  candidates      Layer1 {:.2}, Layer2 {:.2} master faces per slave node (mean)", j.layer1_mean, j.layer2_mean);
+            let _ = writeln!(
+                s,
+                "  NTN             max distance to O {:.4e} m (slave node {}); {} of {} slave nodes conforming",
+                j.ntn_max_distance, j.ntn_max_node_tag, j.ntn_conforming, j.slave_nodes
+            );
+            let _ = writeln!(s, "  surface gap     max {:.4e} m", j.max_surface_distance);
+            let _ = writeln!(s, "  VTU             {}", j.vtu.display());
+        }
+        let _ = writeln!(s, "joints.json     {}", self.json.display());
+        let _ = writeln!(s, "summary         {}", self.out_dir.join("summary.json").display());
+        s
+    }
+}

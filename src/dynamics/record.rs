@@ -80,7 +80,11 @@ fn parse_two_column(text: &str, path: &Path) -> Result<Record, RecordError> {
         let tv: f64 = ts.parse().map_err(|_| line_err(path, k + 1, format!("time `{ts}` is not a number")))?;
         let av: f64 = as_.parse().map_err(|_| line_err(path, k + 1, format!("acceleration `{as_}` is not a number")))?;
         if !tv.is_finite() || !av.is_finite() {
-            return Err(line_err(path, k + 1, "non-finite value"));
+            return Err(line_err(
+                path,
+                k + 1,
+                format!("non-finite value in `{l}`. Replace it with a number (fill the gap or cut the record before it)."),
+            ));
         }
         t.push(tv);
         a.push(av);
@@ -130,7 +134,11 @@ fn parse_at2(text: &str, path: &Path) -> Result<Record, RecordError> {
         for s in l.split_whitespace() {
             let v: f64 = s.parse().map_err(|_| line_err(path, k + 1, format!("`{s}` is not a number")))?;
             if !v.is_finite() {
-                return Err(line_err(path, k + 1, "non-finite value"));
+                return Err(line_err(
+                    path,
+                    k + 1,
+                    format!("non-finite value `{s}`. Replace it with a number (fill the gap or cut the record before it)."),
+                ));
             }
             a.push(v);
         }

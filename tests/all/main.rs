@@ -2,6 +2,8 @@
 //! validation, studies, bad input, regressions named after the bug they pin).
 //! Physics tests state their reference and tolerance in a comment.
 
+mod bad_input;
+mod cli;
 mod common;
 mod contact;
 mod dynamics;

@@ -1,0 +1,263 @@
+//! Bad input through the library (`pipeline::run`, `pipeline::tag`): every error must NAME the
+//! culprit (key, group, file, element, line, value) and say what to fix. Scenes are written into
+//! scratch directories and point at the committed fixtures by absolute path.
+use crate::common::{fixture, scratch};
+use jointquake::mesh::Mesh;
+use jointquake::model::Model;
+use jointquake::pipeline::{run, tag, RunOptions};
+use jointquake::scene::Scene;
+use serde_json::{json, Value};
+use std::path::PathBuf;
+
+/// Write `scene` as `<scratch(test)>/scene.json`; returns (scene path, scratch dir).
+fn write_scene(test: &str, scene: &Value) -> (PathBuf, PathBuf) {
+    let dir = scratch(&format!("bad_input/{test}"));
+    let p = dir.join("scene.json");
+    std::fs::write(&p, serde_json::to_string_pretty(scene).unwrap()).unwrap();
+    (p, dir)
+}
+
+/// A small valid scene on the 10-hex column fixture; tests break one thing in it.
+fn column_scene() -> Value {
+    json!({
+        "geometry": {"msh": fixture("column_hex.msh")},
+        "materials": [{"group": "block:column", "E": 30e9, "nu": 0.2, "rho": 2400}],
+        "boundary": [{"group": "bc:base"}],
+        "time": {"duration": 0.001},
+        "output": {"frames": false}
+    })
+}
+
+/// The error message of `run` on `scene` (which must fail).
+fn run_error(test: &str, scene: &Value) -> String {
+    let (p, dir) = write_scene(test, scene);
+    let opts = RunOptions { out_dir: Some(dir.join("out")), mesh_cache: Some(dir.join("mesh")), progress: false };
+    match run(&p, &opts) {
+        Ok(_) => panic!("{test}: the run should fail"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn assert_mentions(msg: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(msg.contains(p), "message does not mention {p:?}:\n{msg}");
+    }
+}
+
+#[test]
+fn control_the_base_scene_runs() {
+    // Guards the tests below: each breaks exactly one thing in a scene that runs.
+    let (p, dir) = write_scene("control", &column_scene());
+    let opts = RunOptions { out_dir: Some(dir.join("out")), ..Default::default() };
+    let s = run(&p, &opts).expect("the unbroken scene runs");
+    assert!(s.steps > 0);
+}
+
+#[test]
+fn unknown_scene_key_is_named() {
+    let mut s = column_scene();
+    s["dampng"] = json!({"ratio": 0.05});
+    let msg = run_error("unknown_key", &s);
+    assert_mentions(&msg, &["unknown field `dampng`", "`damping`", "docs/scenes.md", "scene.json"]);
+}
+
+#[test]
+fn unknown_key_in_a_nested_section_is_named() {
+    let mut s = column_scene();
+    s["time"]["durration"] = json!(1.0);
+    let msg = run_error("unknown_nested_key", &s);
+    assert_mentions(&msg, &["unknown field `durration`", "`duration`"]);
+}
+
+#[test]
+fn unknown_material_group_is_named_with_the_available_ones() {
+    let mut s = column_scene();
+    s["materials"][0]["group"] = json!("block:colum");
+    let msg = run_error("unknown_material_group", &s);
+    assert_mentions(&msg, &["\"block:colum\"", "Groups in the mesh", "\"block:column\" (dim 3)", "\"bc:base\""]);
+}
+
+#[test]
+fn unknown_boundary_group_is_named() {
+    let mut s = column_scene();
+    s["boundary"][0]["group"] = json!("bc:bottom");
+    let msg = run_error("unknown_boundary_group", &s);
+    assert_mentions(&msg, &["\"bc:bottom\"", "Groups in the mesh", "\"bc:base\""]);
+}
+
+#[test]
+fn missing_record_names_the_path() {
+    let mut s = column_scene();
+    s["loads"] = json!({"base": [{"record": "records/no_such_record.txt", "direction": [1, 0, 0]}]});
+    let (p, dir) = write_scene("missing_record", &s);
+    let msg = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap_err().to_string();
+    // relative record paths are resolved against the scene's directory, and the message shows the result
+    let want = dir.join("records/no_such_record.txt");
+    assert_mentions(&msg, &[&want.display().to_string(), "Check the `record` path"]);
+}
+
+/// Tag of the one tet4 of `block:upper` whose nodes differ between boxes_tet.msh and
+/// inverted_tet.msh (found by comparison, so the test does not depend on the number).
+fn altered_element() -> u64 {
+    let a = Mesh::from_msh(fixture("boxes_tet.msh")).unwrap();
+    let b = Mesh::from_msh(fixture("inverted_tet.msh")).unwrap();
+    let g = b.group("block:upper").unwrap();
+    let changed: Vec<u64> = g.cells.iter().filter(|&&c| a.cells[c].nodes() != b.cells[c].nodes()).map(|&c| b.cells[c].tag).collect();
+    assert_eq!(changed.len(), 1, "exactly one element is altered: {changed:?}");
+    changed[0]
+}
+
+#[test]
+fn inverted_element_is_named_with_its_group() {
+    let s = json!({
+        "geometry": {"msh": fixture("inverted_tet.msh")},
+        "materials": [
+            {"group": "block:lower", "E": 30e9, "nu": 0.2, "rho": 2400},
+            {"group": "block:upper", "E": 30e9, "nu": 0.2, "rho": 2400}
+        ],
+        "boundary": [{"group": "bc:base"}],
+        "time": {"duration": 0.001}
+    });
+    let msg = run_error("inverted", &s);
+    let tag = altered_element();
+    assert_eq!(tag, 405, "tests/fixtures/README.md documents element 405");
+    assert_mentions(&msg, &["inverted_tet.msh", &format!("element {tag} is inverted"), "\"block:upper\"", "ReverseMesh"]);
+}
+
+#[test]
+fn time_step_above_the_limit_quotes_the_limit_and_the_critical_element() {
+    let mut s = column_scene();
+    s["time"]["dt"] = json!(1.0);
+    let msg = run_error("dt_unstable", &s);
+    // the reference: the model's own stable step and critical element
+    let scene: Scene = serde_json::from_value(column_scene()).unwrap();
+    let model = Model::build(Mesh::from_msh(fixture("column_hex.msh")).unwrap(), &scene).unwrap();
+    let limit = format!("{:.4e} s", model.stable_dt());
+    assert_mentions(
+        &msg,
+        &["dt = 1.0000e0 s", &format!("stability limit {limit}"), &format!("critical element {}", model.critical.tag), "\"block:column\"", "\"courant\""],
+    );
+}
+
+#[test]
+fn malformed_msh_names_the_file() {
+    let mut s = column_scene();
+    s["geometry"]["msh"] = json!(fixture("malformed.msh"));
+    let msg = run_error("malformed_msh", &s);
+    assert_mentions(&msg, &[&fixture("malformed.msh").display().to_string(), "not a valid MSH 4.1 file", "-format msh41"]);
+}
+
+#[test]
+fn missing_msh_names_the_file() {
+    let mut s = column_scene();
+    s["geometry"]["msh"] = json!("meshes/not_there.msh");
+    let (p, dir) = write_scene("missing_msh", &s);
+    let msg = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap_err().to_string();
+    assert_mentions(&msg, &["cannot read mesh file", &dir.join("meshes/not_there.msh").display().to_string(), "`geometry.msh`"]);
+}
+
+/// A scene on the column with a base record written into the scratch dir.
+fn record_error(test: &str, record: &str) -> (String, PathBuf) {
+    let dir = scratch(&format!("bad_input/{test}"));
+    let rec = dir.join("record.txt");
+    std::fs::write(&rec, record).unwrap();
+    let mut s = column_scene();
+    s["loads"] = json!({"base": [{"record": rec, "direction": [1, 0, 0]}]});
+    let p = dir.join("scene.json");
+    std::fs::write(&p, s.to_string()).unwrap();
+    let msg = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap_err().to_string();
+    (msg, rec)
+}
+
+#[test]
+fn record_with_uneven_steps_names_the_line() {
+    // line 1 is a comment; the third sample (line 4) comes 0.015 s after the second
+    let (msg, rec) = record_error("uneven_record", "# t [s]  a [g]\n0 0\n0.01 0.1\n0.025 0.2\n0.03 0\n");
+    assert_mentions(&msg, &[&rec.display().to_string(), "line 4", "uneven time step", "Resample"]);
+}
+
+#[test]
+fn record_with_a_non_finite_value_names_the_line_and_value() {
+    let (msg, rec) = record_error("nan_record", "0 0\n0.01 0.1\n0.02 NaN\n0.03 0\n");
+    assert_mentions(&msg, &[&rec.display().to_string(), "line 3", "NaN", "Replace it with a number"]);
+}
+
+#[test]
+fn courant_above_one_is_refused() {
+    let mut s = column_scene();
+    s["time"]["courant"] = json!(1.5);
+    let msg = run_error("courant", &s);
+    assert_mentions(&msg, &["time.courant = 1.5", "must be in (0, 1]"]);
+}
+
+#[test]
+fn boundary_component_other_than_xyz_is_named() {
+    let mut s = column_scene();
+    s["boundary"][0]["fix"] = json!(["x", "w"]);
+    let msg = run_error("component", &s);
+    assert_mentions(&msg, &["boundary \"bc:base\"", "component \"w\"", "\"x\", \"y\" or \"z\""]);
+}
+
+/// Scene on the 4x3 boxes with one joint, for `tag`.
+fn boxes_scene(master: &str, slave: &str) -> Value {
+    json!({
+        "geometry": {"msh": fixture("boxes_hex_4x3.msh")},
+        "materials": [
+            {"group": "block:lower", "E": 30e9, "nu": 0.2, "rho": 2400},
+            {"group": "block:upper", "E": 30e9, "nu": 0.2, "rho": 2400}
+        ],
+        "time": {"duration": 0.0},
+        "joints": [{"name": "J", "master": master, "slave": slave}]
+    })
+}
+
+fn tag_error(test: &str, scene: &Value) -> String {
+    let (p, dir) = write_scene(test, scene);
+    match tag(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }) {
+        Ok(_) => panic!("{test}: tagging should fail"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn unknown_joint_group_is_named_with_the_available_ones() {
+    let msg = tag_error("tag_unknown_group", &boxes_scene("joint:J:lowr", "joint:J:upper"));
+    assert_mentions(&msg, &["joint \"J\"", "\"joint:J:lowr\"", "Groups in the mesh", "\"joint:J:lower\" (dim 2)"]);
+}
+
+#[test]
+fn tag_without_joints_says_what_to_add() {
+    let mut s = boxes_scene("a", "b");
+    s["joints"] = json!([]);
+    let msg = tag_error("tag_no_joints", &s);
+    assert_mentions(&msg, &["no joints to tag", "`joints`", "docs/scenes.md"]);
+}
+
+#[test]
+fn tag_with_a_tolerance_too_small_names_the_far_node() {
+    // A master group that does not face the slave: bc:base is the bottom of the lower box
+    // (z = -0.5 m), the slave joint:J:upper lies on z = 0, so every slave node is 0.5 m away.
+    let mut s = boxes_scene("bc:base", "joint:J:upper");
+    s["joints"][0]["tolerance"] = json!(1e-3);
+    let msg = tag_error("tag_far", &s);
+    assert_mentions(&msg, &["joint \"J\"", "\"joint:J:upper\"", "\"bc:base\"", "tolerance 1.000e-3 m", "5.000000e-1 m from the master surface", "raise the tolerance"]);
+}
+
+#[test]
+fn duplicate_joint_file_names_are_refused() {
+    let mut s = boxes_scene("joint:J:lower", "joint:J:upper");
+    s["joints"] = json!([
+        {"name": "J/1", "master": "joint:J:lower", "slave": "joint:J:upper"},
+        {"name": "J_1", "master": "joint:J:lower", "slave": "joint:J:upper"}
+    ]);
+    let msg = tag_error("tag_duplicate_names", &s);
+    assert_mentions(&msg, &["joint \"J_1\"", "J_1.vtu", "\"J/1\"", "distinct names"]);
+}
+
+#[test]
+fn material_on_a_face_group_says_a_volume_group_is_needed() {
+    let mut s = column_scene();
+    s["materials"][0]["group"] = json!("bc:base");
+    let msg = run_error("material_on_faces", &s);
+    assert_mentions(&msg, &["\"bc:base\" has dimension 2", "a volume group (tet4/hex8 elements) of dimension 3 is needed", "\"block:column\" (dim 3)"]);
+}
