@@ -3,6 +3,7 @@
 //! Physics tests state their reference and tolerance in a comment.
 
 mod common;
+mod contact_validation;
 mod dynamics;
 mod mesh;
 mod rigid;
