@@ -60,8 +60,7 @@ const BAR_V0: f64 = 1.0;
 /// What one impact run measured.
 #[derive(Debug)]
 struct Impact {
-    /// Time step [s], the step limit used [s] and the element-only limit [s].
-    dt: f64,
+    /// The step limit used [s] and the element-only limit [s].
     dt_limit: f64,
     dt_elements: f64,
     /// 1-D Courant number c dt / h (the one of refs/analytic.py).
@@ -156,7 +155,6 @@ fn impact(method: &str, courant: f64, penalty: f64, energy_tolerance: f64) -> Im
         }
     }
     Impact {
-        dt,
         dt_limit,
         dt_elements,
         courant_1d: c * dt / h,
