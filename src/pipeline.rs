@@ -332,8 +332,12 @@ impl RunSummary {
                 if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
             );
             let e = &j.events;
-            if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures + e.recentred > 0 {
-                let _ = writeln!(s, "                 search: {} re-centrings, {} Layer2 widenings, {} fresh searches, {} node-steps lost, {} projection failures", e.recentred, e.widened_layer2, e.fresh_searches, e.lost, e.projection_failures);
+            if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures + e.recentred + e.perimeter_kept > 0 {
+                let _ = writeln!(
+                    s,
+                    "                 search: {} re-centrings, {} kept at the perimeter, {} Layer2 widenings, {} fresh searches, {} node-steps lost, {} projection failures",
+                    e.recentred, e.perimeter_kept, e.widened_layer2, e.fresh_searches, e.lost, e.projection_failures
+                );
             }
         }
         for n in &self.notes {

@@ -356,9 +356,12 @@ pub struct JointSceneSpec {
     /// Tied (bonded, never opens or slides). Default false.
     #[serde(default)]
     pub tied: Option<bool>,
-    /// Inside-test tolerance as a fraction of the master face size [-]. Default 0.01: a slave node
-    /// that far outside the master surface's boundary (line of intersection, crest) still contacts
-    /// the edge face, so round-off and elastic deformation do not drop the joint's boundary nodes.
+    /// Perimeter tolerance as a fraction of the master face size [-]. Default 1e-3. A slave node
+    /// that finds no face with the strict inside test (1e-8) is tried on its candidate faces with
+    /// this tolerance before widening: where both sides of a joint end on the same line (a line of
+    /// intersection, a crest, blocks of the same plan) round-off or lateral elastic strain puts the
+    /// edge nodes just outside the master, and without it they are lost and sink into it.
+    /// 1e-3 h is above elastic lateral mismatches of rock and concrete joints (strain ≤ 1e-3).
     #[serde(default)]
     pub edge_tolerance: Option<f64>,
     /// Penalty stiffness per unit area [Pa/m] for method "penalty".

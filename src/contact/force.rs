@@ -22,7 +22,7 @@
 
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force, PairHistory, PairState};
-use super::query::select_projection;
+use super::query::{select_projection, INSIDE_TOL_DEFAULT};
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
 use crate::model::Model;
@@ -61,7 +61,11 @@ pub struct SearchEvents {
     pub lost: u64,
     /// Quad projections that did not converge (the face was skipped).
     pub projection_failures: u64,
+    /// Node-steps kept in contact by the joint's `edge_tolerance`: the node was just outside the
+    /// master surface's edge, its weights extrapolated.
+    pub perimeter_kept: u64,
 }
+
 
 /// Contact history of one joint.
 #[derive(Clone, Debug, Default)]
@@ -209,6 +213,7 @@ fn project_on(
     n: &Vector3<f64>,
     u: &[f64],
     failures: &mut u64,
+    tol: f64,
 ) -> Option<(usize, super::query::Projection)> {
     let m = &j.tag.master;
     let mut pts: Vec<(usize, [Vector3<f64>; 4], usize)> = Vec::with_capacity(faces.len());
@@ -221,14 +226,14 @@ fn project_on(
         }
         pts.push((f as usize, x, nodes.len()));
     }
-    match select_projection(xs, n, pts.iter().map(|(f, x, k)| (*f, &x[..*k])), j.edge_tolerance) {
+    match select_projection(xs, n, pts.iter().map(|(f, x, k)| (*f, &x[..*k])), tol) {
         Ok(p) => p,
         Err(_) => {
             // a face whose quad solve failed: retry without the failing faces one by one
             *failures += 1;
             let mut best: Option<(usize, super::query::Projection)> = None;
             for (f, x, k) in &pts {
-                if let Ok(Some((ff, p))) = select_projection(xs, n, std::iter::once((*f, &x[..*k])), j.edge_tolerance) {
+                if let Ok(Some((ff, p))) = select_projection(xs, n, std::iter::once((*f, &x[..*k])), tol) {
                     best = match best {
                         Some((bf, bp)) if bp.t.abs() <= p.t.abs() => Some((bf, bp)),
                         _ => Some((ff, p)),
@@ -275,15 +280,24 @@ impl Correction for ContactSolver<'_> {
                         self.candidates_into(j, pr.center, j.layer);
                         let mut found = {
                             let cand = std::mem::take(&mut self.cand);
-                            let r = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures);
+                            let r = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                             self.cand = cand;
                             r
                         };
+                        if found.is_none() {
+                            // a node just off the master's free edge (see `edge_tolerance`)
+                            let cand = std::mem::take(&mut self.cand);
+                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance);
+                            self.cand = cand;
+                            if found.is_some() {
+                                rec.events.perimeter_kept += 1;
+                            }
+                        }
                         if found.is_none() && j.on_exit == OnExit::Widen {
                             if j.layer < 2 {
                                 self.candidates_into(j, pr.center, 2);
                                 let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                                 self.cand = cand;
                                 if found.is_some() {
                                     rec.events.widened_layer2 += 1;
@@ -313,7 +327,7 @@ impl Correction for ContactSolver<'_> {
                                 rec.pairs[i].center = c as u32;
                                 self.candidates_into(j, c as u32, 2);
                                 let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                                 self.cand = cand;
                             }
                         }

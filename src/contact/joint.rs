@@ -99,7 +99,7 @@ impl ContactJoint {
             "report" => OnExit::Report,
             other => return Err(bad(format!("on_exit \"{other}\" is not \"widen\" or \"report\""))),
         };
-        let edge_tolerance = spec.edge_tolerance.unwrap_or(0.01);
+        let edge_tolerance = spec.edge_tolerance.unwrap_or(1e-3);
         if !(edge_tolerance > 0.0 && edge_tolerance < 0.5) {
             return Err(bad(format!("edge_tolerance = {edge_tolerance} must be in (0, 0.5) (fraction of the face size)")));
         }

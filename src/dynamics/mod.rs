@@ -305,9 +305,12 @@ impl ExplicitSolver {
         if e.error.abs() > e.max_error.abs() {
             e.max_error = e.error;
         }
+        // contact forces only dissipate (friction, plastic closure) or store and return energy
+        // (penalty springs): their cumulative work is never positive in a correct run
+        let contact_creates = e.contact_work > self.energy_tolerance * e.scale;
         let reference = e.initial.abs() + e.external_work.abs() + e.contact_work.abs() + e.mass_damping.abs() + e.stiffness_damping.abs();
         let growth = reference > 0.0 && ke + se > 20.0 * reference;
-        if (e.error > self.energy_tolerance || growth) && e.scale > 1e-300 {
+        if (e.error > self.energy_tolerance || growth || contact_creates) && e.scale > 1e-300 {
             let (node, _) = (0..model.n_nodes())
                 .map(|n| {
                     let v: f64 = (0..3).map(|c| (state.u[3 * n + c] - state.u_prev[3 * n + c]).powi(2)).sum();
@@ -317,12 +320,20 @@ impl ExplicitSolver {
             return Err(StepError::EnergyGrowth {
                 step: state.step,
                 t: state.t,
-                error: if growth { (ke + se) / reference } else { e.error },
+                error: if growth {
+                    (ke + se) / reference
+                } else if contact_creates {
+                    e.contact_work / e.scale
+                } else {
+                    e.error
+                },
                 limit: if growth { 20.0 } else { self.energy_tolerance },
                 node: model.mesh.node_tags[node] as usize,
                 x: model.mesh.nodes[node],
                 cause: if growth {
                     "instability: the time step is above the limit of the stiffest element, contact or penalty spring".into()
+                } else if contact_creates {
+                    "contact forces did positive work (energy created at the joints): with penalty contact, lower `time.courant` (e.g. 0.5) or the penalty stiffness".into()
                 } else {
                     "contact forces creating energy (check the joint law, penalty stiffness and time step)".into()
                 },

@@ -6,6 +6,7 @@ mod bad_input;
 mod cli;
 mod common;
 mod contact;
+mod contact_validation;
 mod dynamics;
 mod mesh;
 mod rigid;
