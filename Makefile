@@ -14,7 +14,7 @@ SCENE     ?= pipelines/demo.json
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures wedge-fs
+.PHONY: demo test venv build mesh run bench clean fixtures
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -50,7 +50,7 @@ test: venv
 	@echo "== gmsh path: mesh a .geo through the CLI and run it"
 	cargo build --release
 	$(BIN) mesh pipelines/demo.json
-	GMSH=$(GMSH) cargo test --release -- --ignored
+	GMSH=$(GMSH) cargo test --release --test all -- --ignored gmsh
 	@echo "== meshio cross-check of the demo output"
 	$(BIN) run pipelines/demo.json --out target/test-demo --quiet
 	$(PY) scripts/check_vtu.py target/test-demo
