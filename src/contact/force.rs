@@ -121,6 +121,8 @@ struct Active {
     nm: u8,
     weights: [f64; 4],
     dt2w: f64,
+    /// Update counter when the pair was last evaluated (0: not yet this step).
+    seen: u64,
     /// Applied force components (r_n compressive, r_t) of the current Gauss–Seidel iterate.
     r_n: f64,
     r_t: Vector2<f64>,
@@ -141,6 +143,10 @@ pub struct ContactSolver<'m> {
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
     inv_mass: Vec<f64>,
     cand: Vec<u32>,
+    /// Per node: value of `counter` at its last Gauss–Seidel update. A pair none of whose nodes
+    /// changed since its last evaluation would give the same force again and is skipped (exact).
+    node_stamp: Vec<u64>,
+    counter: u64,
 }
 
 impl<'m> ContactSolver<'m> {
@@ -149,7 +155,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, active: Vec::new(), penalty: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-10 * size.max(1e-300), gs_max_sweeps: 200, active: Vec::new(), penalty: Vec::new(), node_stamp: vec![0; model.n_nodes()], counter: 0, inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -216,7 +222,11 @@ fn project_on(
     tol: f64,
 ) -> Option<(usize, super::query::Projection)> {
     let m = &j.tag.master;
-    let mut pts: Vec<(usize, [Vector3<f64>; 4], usize)> = Vec::with_capacity(faces.len());
+    // candidate sets are small (Layer2 of a structured quad mesh: 16 faces); the stack buffer
+    // avoids an allocation per node and step, larger sets fall back to the heap
+    let mut stack: [(usize, [Vector3<f64>; 4], usize); 24] = [(0, [Vector3::zeros(); 4], 0); 24];
+    let mut heap: Vec<(usize, [Vector3<f64>; 4], usize)> = Vec::new();
+    let mut count = 0;
     for &f in faces {
         let face = &m.faces[f as usize];
         let nodes = face.nodes();
@@ -224,15 +234,24 @@ fn project_on(
         for (a, &nd) in nodes.iter().enumerate() {
             x[a] = pos(model, u, nd as usize);
         }
-        pts.push((f as usize, x, nodes.len()));
+        if count < stack.len() {
+            stack[count] = (f as usize, x, nodes.len());
+        } else {
+            if heap.is_empty() {
+                heap.extend_from_slice(&stack);
+            }
+            heap.push((f as usize, x, nodes.len()));
+        }
+        count += 1;
     }
+    let pts: &[(usize, [Vector3<f64>; 4], usize)] = if heap.is_empty() { &stack[..count] } else { &heap };
     match select_projection(xs, n, pts.iter().map(|(f, x, k)| (*f, &x[..*k])), tol) {
         Ok(p) => p,
         Err(_) => {
             // a face whose quad solve failed: retry without the failing faces one by one
             *failures += 1;
             let mut best: Option<(usize, super::query::Projection)> = None;
-            for (f, x, k) in &pts {
+            for (f, x, k) in pts {
                 if let Ok(Some((ff, p))) = select_projection(xs, n, std::iter::once((*f, &x[..*k])), tol) {
                     best = match best {
                         Some((bf, bp)) if bp.t.abs() <= p.t.abs() => Some((bf, bp)),
@@ -432,6 +451,7 @@ impl Correction for ContactSolver<'_> {
                     nm,
                     weights,
                     dt2w: dt2 * w,
+                    seen: 0,
                     r_n: 0.0,
                     r_t: Vector2::zeros(),
                     hist: pr.hist,
@@ -475,6 +495,15 @@ impl Correction for ContactSolver<'_> {
             let mut max_dg: f64 = 0.0;
             for k in 0..self.active.len() {
                 let a = self.active[k];
+                if a.seen > 0 {
+                    let mut changed = self.node_stamp[a.slave as usize] >= a.seen;
+                    for b in 0..a.nm as usize {
+                        changed |= self.node_stamp[a.masters[b] as usize] >= a.seen;
+                    }
+                    if !changed {
+                        continue;
+                    }
+                }
                 let j = &self.joints[a.joint as usize];
                 let i = a.pair as usize;
                 let [n, t1, t2] = j.frames[i];
@@ -496,7 +525,12 @@ impl Correction for ContactSolver<'_> {
                 let resp = pair_force(&j.law, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i]);
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
+                self.counter += 1;
                 if d_rn != 0.0 || d_rt.x != 0.0 || d_rt.y != 0.0 {
+                    self.node_stamp[s] = self.counter;
+                    for b in 0..a.nm as usize {
+                        self.node_stamp[a.masters[b] as usize] = self.counter;
+                    }
                     let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
                     let im = self.inv_mass[s];
                     if im > 0.0 {
@@ -516,6 +550,8 @@ impl Correction for ContactSolver<'_> {
                     max_dg = max_dg.max(a.dt2w * (d_rn.abs() + d_rt.norm()));
                 }
                 let e = &mut self.active[k];
+                // evaluated after its own update: later changes of its nodes carry larger stamps
+                e.seen = self.counter + 1;
                 e.r_n = resp.r_n;
                 e.r_t = resp.r_t;
                 e.hist = resp.hist;
