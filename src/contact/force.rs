@@ -155,7 +155,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-10 * size.max(1e-300), gs_max_sweeps: 200, active: Vec::new(), penalty: Vec::new(), node_stamp: vec![0; model.n_nodes()], counter: 0, inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, active: Vec::new(), penalty: Vec::new(), node_stamp: vec![0; model.n_nodes()], counter: 0, inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
