@@ -28,6 +28,8 @@ pub enum Error {
     Output(#[from] OutputError),
     #[error(transparent)]
     Rigid(#[from] crate::rigid::RigidError),
+    #[error(transparent)]
+    Report(#[from] ReportError),
 }
 
 /// Reading a `.msh` file or looking up its parts.
@@ -124,6 +126,36 @@ impl OutputError {
     pub fn write(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
         OutputError::Write { path: path.into(), message: e.to_string() }
     }
+}
+
+/// Building study reports: charts (PNG + SVG) and Markdown tables ([`crate::report`]).
+///
+/// Chart variants name the chart by its title and the series by its name; point indices
+/// are 0-based positions in [`crate::report::Series::points`].
+#[derive(Debug, Error)]
+pub enum ReportError {
+    #[error("chart \"{chart}\": series \"{series}\", point {index} = ({x}, {y}) is not finite. Drop the point (a failed run?) or replace it before charting.")]
+    NonFinite { chart: String, series: String, index: usize, x: f64, y: f64 },
+    #[error("chart \"{chart}\": series \"{series}\", point {index} = ({x}, {y}) has {axis} <= 0, which a logarithmic {axis} axis cannot show. Use a linear {axis} axis, or drop or offset the point.")]
+    NonPositiveOnLog { chart: String, series: String, index: usize, x: f64, y: f64, axis: char },
+    #[error("chart \"{chart}\": series \"{series}\" has {labels} point labels for {points} points; give one label per point (an empty string draws none).")]
+    LabelCount { chart: String, series: String, labels: usize, points: usize },
+    #[error("chart \"{chart}\": no points to chart and no explicit x_range and y_range. Add a series with points or set both ranges.")]
+    NoData { chart: String },
+    #[error("chart \"{chart}\": {axis} range ({lo}, {hi}) is invalid: {reason}")]
+    InvalidRange { chart: String, axis: char, lo: f64, hi: f64, reason: String },
+    #[error("chart \"{chart}\": size {width} x {height} px is too small; use at least {min} x {min} px.")]
+    InvalidSize { chart: String, width: u32, height: u32, min: u32 },
+    #[error("chart \"{chart}\": drawing {target} failed: {message}")]
+    Draw { chart: String, target: String, message: String },
+    #[error("cannot write {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("the embedded chart font {font} is not a valid TrueType font (a corrupt assets/fonts checkout?)")]
+    Font { font: String },
+    #[error("table row {row} has {cells} cells but the header has {columns} columns; give one cell per column (an empty string for a blank cell).")]
+    RowWidth { row: usize, cells: usize, columns: usize },
+    #[error("table alignment has {given} entries but the header has {columns} columns; give one alignment per column.")]
+    AlignWidth { given: usize, columns: usize },
 }
 
 /// Message of [`MeshError::UnknownGroup`]: a name that is not in the mesh, or a name that is
