@@ -19,6 +19,7 @@
 //! - scene fields, units and defaults: [`scene`] (and `docs/scenes.md`)
 //! - time integration, damping, stable step: [`dynamics`]
 //! - errors (what the user must fix): [`error`]
+//! - charts (PNG + SVG) and Markdown tables for study reports: [`report`]
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages.
 
@@ -31,6 +32,7 @@ pub mod mesh;
 pub mod model;
 pub mod output;
 pub mod pipeline;
+pub mod report;
 pub mod rigid;
 pub mod scene;
 pub mod study;
