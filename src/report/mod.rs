@@ -16,10 +16,17 @@
 //!
 //! Developer notes: `docs/report.md`.
 
+pub mod chart;
 pub mod file;
+pub mod font;
 pub mod pareto;
+pub mod scale;
 pub mod table;
 
 pub use crate::error::ReportError;
+pub use chart::{
+    Axis, Chart, ChartFiles, ChartPlan, Legend, Marker, Series, SeriesStyle, DEFAULT_HEIGHT, DEFAULT_WIDTH, MARKERS, MIN_SIZE,
+    PALETTE, series_color, series_marker,
+};
 pub use pareto::pareto_front;
 pub use table::{Align, Table, fmt_percent, fmt_sig};

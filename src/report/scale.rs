@@ -1,0 +1,233 @@
+//! Axis arithmetic shared by the chart writers, free of plotters: the map to axis space
+//! (identity or log10), automatic ranges, clipping of polylines and markers to the plotted
+//! window, and tick-label text.
+//!
+//! Everything here works in *axis space*, where both axis kinds are linear: a log axis is
+//! handled as log10 of the value, so margins, clipping and legend placement treat a decade
+//! like any other unit length.
+
+use super::chart::Axis;
+use super::table::fmt_sig;
+
+/// Margin added to each side of an automatic range, as a fraction of the data span in axis
+/// space. 5 % keeps markers at the extremes clear of the frame without wasting the plot.
+pub const AUTO_MARGIN: f64 = 0.05;
+
+/// Half-width of an automatic linear range when all values are equal to `v != 0`, as a
+/// fraction of `|v|`: ±10 % shows the value in the middle with round tick labels around it.
+pub const FLAT_LINEAR_HALF: f64 = 0.1;
+
+/// Half-width, in decades, of an automatic log range when all values are equal: half a
+/// decade each side always brackets at least one power of ten (a labelled tick).
+pub const FLAT_LOG_HALF_DECADES: f64 = 0.5;
+
+/// Value to axis space: identity on a linear axis, log10 on a log axis.
+pub fn to_axis(axis: Axis, v: f64) -> f64 {
+    match axis {
+        Axis::Linear => v,
+        Axis::Log => v.log10(),
+    }
+}
+
+/// Axis space back to value: inverse of [`to_axis`].
+pub fn from_axis(axis: Axis, u: f64) -> f64 {
+    match axis {
+        Axis::Linear => u,
+        Axis::Log => 10f64.powf(u),
+    }
+}
+
+/// Automatic range (in values, not axis space) for data spanning `[lo, hi]` (finite,
+/// `lo <= hi`, both positive on a log axis).
+///
+/// - span > 0: widened by [`AUTO_MARGIN`] of the span on each side (in axis space);
+/// - all equal, linear: `v ± FLAT_LINEAR_HALF·|v|`, or `[-1, 1]` for `v = 0`
+///   (no scale to take a fraction of; ±1 gives round ticks);
+/// - all equal, log: `v ·/÷ 10^FLAT_LOG_HALF_DECADES`.
+///
+/// A log range that then contains no power of ten is widened outward to whole decades, so
+/// the axis always carries at least one labelled tick (plotters labels log axes at powers
+/// of ten and their multiples only).
+pub fn auto_range(axis: Axis, lo: f64, hi: f64) -> (f64, f64) {
+    let (ulo, uhi) = (to_axis(axis, lo), to_axis(axis, hi));
+    let span = uhi - ulo;
+    let (mut a, mut b) = if span > 0.0 {
+        (ulo - AUTO_MARGIN * span, uhi + AUTO_MARGIN * span)
+    } else {
+        match axis {
+            Axis::Linear if ulo == 0.0 => (-1.0, 1.0),
+            Axis::Linear => (ulo - FLAT_LINEAR_HALF * ulo.abs(), ulo + FLAT_LINEAR_HALF * ulo.abs()),
+            Axis::Log => (ulo - FLAT_LOG_HALF_DECADES, ulo + FLAT_LOG_HALF_DECADES),
+        }
+    };
+    if axis == Axis::Log && b.floor() < a {
+        a = a.floor();
+        b = b.ceil();
+    }
+    (from_axis(axis, a), from_axis(axis, b))
+}
+
+/// An axis-aligned window in axis space, with a tolerance so that points lying exactly on
+/// the boundary (within rounding of the log10 round trip) count as inside.
+#[derive(Debug, Clone, Copy)]
+pub struct Window {
+    pub x: (f64, f64),
+    pub y: (f64, f64),
+    tol_x: f64,
+    tol_y: f64,
+}
+
+impl Window {
+    /// Window from axis-space bounds (`x.0 < x.1`, `y.0 < y.1`).
+    pub fn new(x: (f64, f64), y: (f64, f64)) -> Self {
+        // 1e-9 of the span: far below a pixel, far above the log10/powf round-off.
+        Window { x, y, tol_x: 1e-9 * (x.1 - x.0), tol_y: 1e-9 * (y.1 - y.0) }
+    }
+
+    pub fn contains(&self, p: (f64, f64)) -> bool {
+        p.0 >= self.x.0 - self.tol_x && p.0 <= self.x.1 + self.tol_x && p.1 >= self.y.0 - self.tol_y && p.1 <= self.y.1 + self.tol_y
+    }
+
+    /// Position of `p` in the unit square of the window ((0, 0) lower left).
+    pub fn unit(&self, p: (f64, f64)) -> (f64, f64) {
+        ((p.0 - self.x.0) / (self.x.1 - self.x.0), (p.1 - self.y.0) / (self.y.1 - self.y.0))
+    }
+
+    /// Liang–Barsky clip of the segment `p → q`: the parameters `(t0, t1)`, `0 <= t0 <= t1 <= 1`,
+    /// of the part inside the window, or `None` if no part is inside.
+    pub fn clip_segment(&self, p: (f64, f64), q: (f64, f64)) -> Option<(f64, f64)> {
+        let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+        let mut t0 = 0.0f64;
+        let mut t1 = 1.0f64;
+        let edges = [
+            (-dx, p.0 - (self.x.0 - self.tol_x)),
+            (dx, (self.x.1 + self.tol_x) - p.0),
+            (-dy, p.1 - (self.y.0 - self.tol_y)),
+            (dy, (self.y.1 + self.tol_y) - p.1),
+        ];
+        for (den, num) in edges {
+            if den == 0.0 {
+                if num < 0.0 {
+                    return None;
+                }
+            } else {
+                let t = num / den;
+                if den < 0.0 {
+                    t0 = t0.max(t);
+                } else {
+                    t1 = t1.min(t);
+                }
+            }
+        }
+        (t0 <= t1).then_some((t0, t1))
+    }
+
+    /// Clips the polyline `points` (axis space) to the window: the visible pieces, each with
+    /// at least two vertices, in order. A polyline that leaves and re-enters the window gives
+    /// several pieces, so nothing is drawn along the frame.
+    pub fn clip_polyline(&self, points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
+        let lerp = |p: (f64, f64), q: (f64, f64), t: f64| (p.0 + t * (q.0 - p.0), p.1 + t * (q.1 - p.1));
+        let mut pieces: Vec<Vec<(f64, f64)>> = Vec::new();
+        let mut open = false;
+        for w in points.windows(2) {
+            let (p, q) = (w[0], w[1]);
+            match self.clip_segment(p, q) {
+                Some((t0, t1)) => {
+                    let b = if t1 >= 1.0 { q } else { lerp(p, q, t1) };
+                    if open && t0 <= 0.0 {
+                        pieces.last_mut().expect("open piece").push(b);
+                    } else {
+                        let a = if t0 <= 0.0 { p } else { lerp(p, q, t0) };
+                        pieces.push(vec![a, b]);
+                    }
+                    open = t1 >= 1.0;
+                }
+                None => open = false,
+            }
+        }
+        pieces
+    }
+}
+
+/// Tick-label text: six significant digits, trailing zeros dropped ("0.3", "250000",
+/// "1e-6"), so labels are short and never show binary round-off like 0.30000000000000004.
+pub fn fmt_tick(v: f64) -> String {
+    if v == 0.0 {
+        return "0".to_string();
+    }
+    let s = fmt_sig(v, 6);
+    let (mantissa, exponent) = match s.split_once('e') {
+        Some((m, e)) => (m, Some(e)),
+        None => (s.as_str(), None),
+    };
+    let mantissa = if mantissa.contains('.') { mantissa.trim_end_matches('0').trim_end_matches('.') } else { mantissa };
+    match exponent {
+        Some(e) => format!("{mantissa}e{e}"),
+        None => mantissa.to_string(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn auto_range_linear_adds_margin_and_handles_flat_data() {
+        let (a, b) = auto_range(Axis::Linear, 0.0, 10.0);
+        assert!((a + 0.5).abs() < 1e-12 && (b - 10.5).abs() < 1e-12, "{a} {b}");
+        assert_eq!(auto_range(Axis::Linear, 0.0, 0.0), (-1.0, 1.0));
+        let (a, b) = auto_range(Axis::Linear, -2.0, -2.0);
+        assert!((a + 2.2).abs() < 1e-12 && (b + 1.8).abs() < 1e-12, "{a} {b}");
+    }
+
+    #[test]
+    fn auto_range_log_is_symmetric_in_decades_and_holds_a_power_of_ten() {
+        // 1e-3 .. 1e1: four decades, 0.2 decade margin each side.
+        let (a, b) = auto_range(Axis::Log, 1e-3, 10.0);
+        assert!((a.log10() + 3.2).abs() < 1e-12 && (b.log10() - 1.2).abs() < 1e-12, "{a} {b}");
+        // Flat: half a decade each side.
+        let (a, b) = auto_range(Axis::Log, 3.0, 3.0);
+        assert!((a * 10f64.sqrt() - 3.0).abs() < 1e-12 && (b / 10f64.sqrt() - 3.0).abs() < 1e-12);
+        // 2..3 brackets no power of ten: widened to the decade 1..10.
+        let (a, b) = auto_range(Axis::Log, 2.0, 3.0);
+        assert!((a - 1.0).abs() < 1e-12 && (b - 10.0).abs() < 1e-12, "{a} {b}");
+    }
+
+    #[test]
+    fn clip_polyline_splits_at_the_frame_and_keeps_inner_vertices() {
+        let w = Window::new((0.0, 1.0), (0.0, 1.0));
+        // Inside, out through the right edge, back in: two pieces.
+        let pieces = w.clip_polyline(&[(0.2, 0.5), (0.5, 0.5), (1.5, 0.5), (0.8, 0.2), (0.6, 0.2)]);
+        assert_eq!(pieces.len(), 2, "{pieces:?}");
+        // Clipped at the frame, within the window's boundary tolerance (1e-9 of the span).
+        let close = |a: &[(f64, f64)], b: &[(f64, f64)]| a.len() == b.len() && a.iter().zip(b).all(|(p, q)| (p.0 - q.0).abs() < 1e-6 && (p.1 - q.1).abs() < 1e-6);
+        assert!(close(&pieces[0], &[(0.2, 0.5), (0.5, 0.5), (1.0, 0.5)]), "{pieces:?}");
+        let first = pieces[1][0];
+        assert!((first.0 - 1.0).abs() < 1e-6 && pieces[1].last() == Some(&(0.6, 0.2)), "{pieces:?}");
+        // Entirely outside: nothing.
+        assert!(w.clip_polyline(&[(2.0, 2.0), (3.0, 2.0)]).is_empty());
+        // A segment crossing the window without a vertex inside.
+        let pieces = w.clip_polyline(&[(-1.0, 0.5), (2.0, 0.5)]);
+        assert_eq!(pieces.len(), 1);
+        assert!((pieces[0][0].0 - 0.0).abs() < 1e-6 && (pieces[0][1].0 - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn boundary_points_count_as_inside() {
+        let (a, b) = (1e-3f64.log10(), 10f64.log10());
+        let w = Window::new((a, b), (0.0, 1.0));
+        assert!(w.contains((10f64.log10(), 1.0)));
+        assert!(w.contains((1e-3f64.log10(), 0.0)));
+        assert!(!w.contains((20f64.log10(), 0.5)));
+    }
+
+    #[test]
+    fn tick_text_is_short() {
+        assert_eq!(fmt_tick(0.1 + 0.2), "0.3");
+        assert_eq!(fmt_tick(250000.0), "250000");
+        assert_eq!(fmt_tick(1e-6), "1e-6");
+        assert_eq!(fmt_tick(-2.5e7), "-2.5e7");
+        assert_eq!(fmt_tick(0.0), "0");
+        assert_eq!(fmt_tick(1.0), "1");
+    }
+}
