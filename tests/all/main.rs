@@ -9,5 +9,6 @@ mod contact;
 mod contact_validation;
 mod dynamics;
 mod mesh;
+mod report;
 mod rigid;
 mod tagging;
