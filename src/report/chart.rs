@@ -55,7 +55,7 @@ const FONT_POINT_LABEL: u32 = 14;
 /// like "-1.2345e-5" beside a rotated axis label.
 const MARGIN: u32 = 20;
 const X_LABEL_AREA: u32 = 55;
-const Y_LABEL_AREA: u32 = 80;
+const Y_LABEL_AREA: u32 = 90;
 /// Light grid lines between labelled ticks: 4 marks fifths, enough to read values off the
 /// chart without the grid competing with the data (plotters' default of 10 does).
 const LIGHT_LINES: usize = 4;
@@ -514,15 +514,18 @@ impl Chart {
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x, y)?;
-        let tick = |v: &f64| fmt_tick(*v);
+        let zero_below = |axis: Axis, range: (f64, f64)| if axis == Axis::Linear { 1e-9 * (range.1 - range.0) } else { 0.0 };
+        let (x_zero, y_zero) = (zero_below(self.x_axis, plan.x_range), zero_below(self.y_axis, plan.y_range));
+        let x_tick = |v: &f64| fmt_tick(*v, x_zero);
+        let y_tick = |v: &f64| fmt_tick(*v, y_zero);
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
             .label_style((FAMILY, FONT_TICKS))
             .axis_desc_style((FAMILY, FONT_AXIS_LABEL))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
+            .x_label_formatter(&x_tick)
+            .y_label_formatter(&y_tick)
             .max_light_lines(LIGHT_LINES)
             .draw()?;
 

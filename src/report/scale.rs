@@ -151,8 +151,10 @@ impl Window {
 
 /// Tick-label text: six significant digits, trailing zeros dropped ("0.3", "250000",
 /// "1e-6"), so labels are short and never show binary round-off like 0.30000000000000004.
-pub fn fmt_tick(v: f64) -> String {
-    if v == 0.0 {
+/// `|v| <= zero_below` prints as "0": pass 1e-9 × the span of a linear axis, so the tick at
+/// zero, computed as a sum of steps, does not read "-2.22045e-16"; pass 0 on a log axis.
+pub fn fmt_tick(v: f64, zero_below: f64) -> String {
+    if v == 0.0 || v.abs() <= zero_below {
         return "0".to_string();
     }
     let s = fmt_sig(v, 6);
@@ -223,11 +225,14 @@ mod tests {
 
     #[test]
     fn tick_text_is_short() {
-        assert_eq!(fmt_tick(0.1 + 0.2), "0.3");
-        assert_eq!(fmt_tick(250000.0), "250000");
-        assert_eq!(fmt_tick(1e-6), "1e-6");
-        assert_eq!(fmt_tick(-2.5e7), "-2.5e7");
-        assert_eq!(fmt_tick(0.0), "0");
-        assert_eq!(fmt_tick(1.0), "1");
+        assert_eq!(fmt_tick(0.1 + 0.2, 0.0), "0.3");
+        assert_eq!(fmt_tick(250000.0, 0.0), "250000");
+        assert_eq!(fmt_tick(1e-6, 0.0), "1e-6");
+        assert_eq!(fmt_tick(-2.5e7, 0.0), "-2.5e7");
+        assert_eq!(fmt_tick(0.0, 0.0), "0");
+        assert_eq!(fmt_tick(1.0, 0.0), "1");
+        // Round-off at zero on a linear axis of span 2.
+        assert_eq!(fmt_tick(-2.220446049250313e-16, 2e-9), "0");
+        assert_eq!(fmt_tick(1e-7, 0.0), "1e-7");
     }
 }
