@@ -24,12 +24,13 @@ DefineConstant[
   Hdef  = {0, Choices{0 = "vertical rise of the line of intersection", 1 = "crest point on plane A above the toe"},
            Name "Parameters/Wedge/H definition"},
   margin = {90, Name "Parameters/Rock/margin beyond the wedge [m] (80-100)"},
+  toe   = {20, Name "Parameters/Rock/slope face below the toe O [m]"},
   hw    = {4,  Name "Parameters/Mesh/wedge element size hw [m]"},
   hr    = {15, Name "Parameters/Mesh/rock element size hr [m]"}
 ];
 
-If (hw <= 0 || hr <= 0 || H <= 0 || margin <= 0)
-  Error("wedge.geo: hw, hr, H and margin must be positive (hw = %g, hr = %g, H = %g, margin = %g)", hw, hr, H, margin);
+If (hw <= 0 || hr <= 0 || H <= 0 || margin <= 0 || toe < 0 || toe >= margin)
+  Error("wedge.geo: hw, hr, H and margin must be positive and 0 <= toe < margin (hw = %g, hr = %g, H = %g, margin = %g, toe = %g)", hw, hr, H, margin, toe);
   Abort;
 EndIf
 
@@ -94,11 +95,14 @@ hu = newv; Box(hu) = {-L/2, -L/2, -L, L, L, L};
 Rotate {{-nUy, nUx, 0}, {0, 0, 0}, dipU*d2r} { Volume{hu}; }
 Translate {0, 0, du/nUz} { Volume{hu}; }
 
-// Slope body (below face and upper slope) united with the toe ground z <= 0.
+// Slope body (below face and upper slope) united with the ground in front of the slope,
+// a horizontal bench at z = -toe: the face continues `toe` metres below the wedge's toe O,
+// so that a wedge sliding out along its line of intersection leaves the face into the air
+// (it reaches the bench only after sliding about toe / sin(plunge) metres).
 body() = BooleanIntersection{ Volume{box}; Delete; }{ Volume{hf}; Delete; };
 body() = BooleanIntersection{ Volume{body()}; Delete; }{ Volume{hu}; Delete; };
-toe = newv; Box(toe) = {xmin, ymin, zmin, xmax - xmin, ymax - ymin, -zmin};
-rock() = BooleanUnion{ Volume{body()}; Delete; }{ Volume{toe}; Delete; };
+bench = newv; Box(bench) = {xmin, ymin, zmin, xmax - xmin, ymax - ymin, -zmin - toe};
+rock() = BooleanUnion{ Volume{body()}; Delete; }{ Volume{bench}; Delete; };
 
 // Remove a throw-away copy of the wedge; the wedge itself is built afresh below from
 // new points, so that wedge and rock share no point, curve or surface: the two blocks

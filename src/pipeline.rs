@@ -152,6 +152,9 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
 
     // ---- gravity equilibrium
     let equilibrium = if loads.gravity.is_some() && scene.equilibrium.method == "relaxation" {
+        if let Some(c) = contact.as_mut() {
+            c.keep_bonds = scene.equilibrium.joint_bonds == "kept";
+        }
         let eq = relax_gravity(
             &model,
             &loads,
@@ -170,6 +173,9 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         }
         if !eq.converged {
             notes.push(format!("gravity equilibrium residual {:.2e} above tolerance {:.1e} (accepted below max_residual)", eq.residual, scene.equilibrium.tolerance));
+        }
+        if let Some(c) = contact.as_mut() {
+            c.keep_bonds = false;
         }
         state.step = 0;
         state.t = 0.0;

@@ -21,7 +21,7 @@
 //! external force of step n (so it is explicit and lowers the stable step).
 
 use super::joint::{ContactJoint, Method, OnExit};
-use super::law::{pair_force, PairHistory, PairState};
+use super::law::{pair_force, JointLaw, PairHistory, PairState};
 use super::query::{select_projection, INSIDE_TOL_DEFAULT};
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
@@ -134,11 +134,18 @@ struct Active {
 /// Scratch and settings of the contact correction. Holds no history (that is in `ContactState`).
 pub struct ContactSolver<'m> {
     pub joints: &'m [ContactJoint],
-    /// Gauss–Seidel stops when the largest gap change of a sweep is below this [m].
-    /// Default 1e-12 × the largest joint size: far below any physical gap.
+    /// Gauss–Seidel stops when no node's displacement changed by more than this over a sweep [m]
+    /// (the net change of the node, so that two pairs sharing a slave node — a node on the
+    /// line where two joints meet — and trading force between their redundant constraints
+    /// without moving it count as converged). Default 1e-12 × the largest joint size: far
+    /// below any physical gap.
     pub gs_tolerance: f64,
     /// Sweep budget per step. Default 200.
     pub gs_max_sweeps: usize,
+    /// While true, every joint keeps its bond (cohesion, tensile strength) after a slip or an
+    /// opening, as with `keep_cohesion`; a tensile rupture still ends it. Default false. The
+    /// pipeline sets it during gravity equilibrium (scene `equilibrium.joint_bonds = "kept"`).
+    pub keep_bonds: bool,
     active: Vec<Active>,
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
     inv_mass: Vec<f64>,
@@ -147,6 +154,9 @@ pub struct ContactSolver<'m> {
     /// changed since its last evaluation would give the same force again and is skipped (exact).
     node_stamp: Vec<u64>,
     counter: u64,
+    /// Per node: displacement change [m] applied during the current sweep, and the nodes touched.
+    sweep_du: Vec<Vector3<f64>>,
+    touched: Vec<u32>,
 }
 
 impl<'m> ContactSolver<'m> {
@@ -155,7 +165,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, active: Vec::new(), penalty: Vec::new(), node_stamp: vec![0; model.n_nodes()], counter: 0, inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, keep_bonds: false, active: Vec::new(), penalty: Vec::new(), node_stamp: vec![0; model.n_nodes()], counter: 0, sweep_du: vec![Vector3::zeros(); model.n_nodes()], touched: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -492,7 +502,6 @@ impl Correction for ContactSolver<'_> {
         let mut converged = self.active.is_empty();
         while !converged && sweeps < self.gs_max_sweeps {
             sweeps += 1;
-            let mut max_dg: f64 = 0.0;
             for k in 0..self.active.len() {
                 let a = self.active[k];
                 if a.seen > 0 {
@@ -522,32 +531,45 @@ impl Correction for ContactSolver<'_> {
                 // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
                 let g_trial = g_cur - a.dt2w * a.r_n;
                 let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-                let resp = pair_force(&j.law, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i]);
+                let resp = if self.keep_bonds && !j.law.keep_cohesion {
+                    let kept = JointLaw { keep_cohesion: true, ..j.law };
+                    pair_force(&kept, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i])
+                } else {
+                    pair_force(&j.law, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i])
+                };
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
                 self.counter += 1;
                 if d_rn != 0.0 || d_rt.x != 0.0 || d_rt.y != 0.0 {
-                    self.node_stamp[s] = self.counter;
-                    for b in 0..a.nm as usize {
-                        self.node_stamp[a.masters[b] as usize] = self.counter;
-                    }
+                    // only nodes that move are stamped: a fixed node never changes a neighbour's force
                     let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
                     let im = self.inv_mass[s];
                     if im > 0.0 {
+                        self.node_stamp[s] = self.counter;
+                        let du = dr * (dt2 * im);
                         for c in 0..3 {
-                            u_next[3 * s + c] += dt2 * dr[c] * im;
+                            u_next[3 * s + c] += du[c];
                         }
+                        if self.sweep_du[s] == Vector3::zeros() {
+                            self.touched.push(s as u32);
+                        }
+                        self.sweep_du[s] += du;
                     }
                     for b in 0..a.nm as usize {
                         let mi = a.masters[b] as usize;
                         let imi = self.inv_mass[mi];
                         if imi > 0.0 {
+                            self.node_stamp[mi] = self.counter;
+                            let du = dr * (-dt2 * a.weights[b] * imi);
                             for c in 0..3 {
-                                u_next[3 * mi + c] -= dt2 * a.weights[b] * dr[c] * imi;
+                                u_next[3 * mi + c] += du[c];
                             }
+                            if self.sweep_du[mi] == Vector3::zeros() {
+                                self.touched.push(mi as u32);
+                            }
+                            self.sweep_du[mi] += du;
                         }
                     }
-                    max_dg = max_dg.max(a.dt2w * (d_rn.abs() + d_rt.norm()));
                 }
                 let e = &mut self.active[k];
                 // evaluated after its own update: later changes of its nodes carry larger stamps
@@ -558,7 +580,13 @@ impl Correction for ContactSolver<'_> {
                 e.state = resp.state;
                 e.gap = g_trial + a.dt2w * resp.r_n;
             }
-            converged = max_dg <= self.gs_tolerance;
+            let mut max_du: f64 = 0.0;
+            for &nd in &self.touched {
+                max_du = max_du.max(self.sweep_du[nd as usize].norm());
+                self.sweep_du[nd as usize] = Vector3::zeros();
+            }
+            self.touched.clear();
+            converged = max_du <= self.gs_tolerance;
         }
 
         // ---------------------------------------------------------------- record

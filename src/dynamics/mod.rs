@@ -200,7 +200,8 @@ impl ExplicitSolver {
                     continue;
                 }
                 let vb = (state.u[i] - state.u_prev[i]) / dt;
-                let a = (self.f_ext[i] - self.f_int[i]) / m - alpha * vb;
+                let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
+                let a = (self.f_ext[i] - self.f_int[i]) / m - an * vb;
                 self.u_next[i] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * a;
             }
         }
@@ -220,7 +221,7 @@ impl ExplicitSolver {
                 if beta > 0.0 {
                     sdamp += du * (self.f_int[i] - self.ku[i]);
                 }
-                if alpha > 0.0 {
+                if alpha > 0.0 && model.mass_damped[i / 3] {
                     let vb = (state.u[i] - state.u_prev[i]) / dt;
                     damp += du * alpha * model.mass[i / 3] * vb;
                 }

@@ -73,6 +73,9 @@ pub struct Model {
     pub fixed: Vec<u8>,
     /// Rayleigh damping C = αM + βK: α [1/s], β [s].
     pub alpha: f64,
+    /// Per node: whether αM applies in the dynamic stage (scene `damping.mass_groups`; all
+    /// nodes by default). Relaxation damping applies to every node regardless.
+    pub mass_damped: Vec<bool>,
     pub beta: f64,
     pub critical: CriticalElement,
     /// Joints (tagged interfaces with their laws), in scene order.
@@ -245,6 +248,19 @@ impl Model {
             }
         }
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
+        let mass_damped = match &scene.damping.mass_groups {
+            None => vec![true; n],
+            Some(groups) => {
+                let mut d = vec![false; n];
+                for g in groups {
+                    mesh.group_of_dim(g, 3)?;
+                    for node in mesh.group_nodes(g)? {
+                        d[node] = true;
+                    }
+                }
+                d
+            }
+        };
         // ---- joints (tagged once on the initial configuration)
         let size = {
             let (lo, hi) = mesh.nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(mut lo, mut hi), x| {
@@ -269,6 +285,7 @@ impl Model {
             mass,
             fixed,
             alpha,
+            mass_damped,
             beta,
             critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
             joints,

@@ -342,14 +342,43 @@ fn check_record(what: &str, a: &[f64]) -> Result<(), RigidError> {
 /// Slide a block with the law `model` under horizontal and (optional) vertical ground
 /// accelerations `a_h`, `a_v` [m/s²] sampled every `opts.dt` from t = 0.
 pub fn slide(model: &SlidingModel, a_h: &[f64], a_v: Option<&[f64]>, opts: &NewmarkOptions) -> Result<NewmarkResult, RigidError> {
-    let dt = super::positive("record time step dt [s]", opts.dt)?;
-    let g = super::positive("g [m/s2]", model.g)?;
+    slide_impl(model, None, a_h, a_v, opts)
+}
+
+/// [`slide`] for a brittle bond: the block follows `intact` until it first starts to slide
+/// and `residual` (e.g. the law without cohesion) from that instant on. The start is located
+/// exactly inside its interval (where the intact rate crosses zero), so the result stays exact
+/// for piecewise-linear input.
+pub fn slide_with_bond_loss(
+    intact: &SlidingModel,
+    residual: &SlidingModel,
+    a_h: &[f64],
+    a_v: Option<&[f64]>,
+    opts: &NewmarkOptions,
+) -> Result<NewmarkResult, RigidError> {
+    if residual.up.is_some() != intact.up.is_some() {
+        return Err(RigidError::invalid("bond-loss sliding: residual law direction (1 = two-way)", residual.up.is_some() as u8 as f64, "must match the intact law's"));
+    }
+    slide_impl(intact, Some(residual), a_h, a_v, opts)
+}
+
+fn check_law(model: &SlidingModel) -> Result<(), RigidError> {
     for (name, l) in [("down", Some(model.down)), ("up", model.up)] {
         if let Some(l) = l
             && !(l.c0.is_finite() && l.ch.is_finite() && l.cv.is_finite())
         {
             return Err(RigidError::invalid(&format!("sliding law ({name}) coefficient"), l.c0 + l.ch + l.cv, "must be finite"));
         }
+    }
+    Ok(())
+}
+
+fn slide_impl(intact: &SlidingModel, residual: Option<&SlidingModel>, a_h: &[f64], a_v: Option<&[f64]>, opts: &NewmarkOptions) -> Result<NewmarkResult, RigidError> {
+    let dt = super::positive("record time step dt [s]", opts.dt)?;
+    let g = super::positive("g [m/s2]", intact.g)?;
+    check_law(intact)?;
+    if let Some(r) = residual {
+        check_law(r)?;
     }
     if a_h.is_empty() {
         return Err(RigidError::invalid("number of record samples", 0.0, "give at least one sample"));
@@ -364,10 +393,13 @@ pub fn slide(model: &SlidingModel, a_h: &[f64], a_v: Option<&[f64]>, opts: &Newm
     let k = |i: usize| -> (f64, f64) {
         if i < a_h.len() { (a_h[i] / g, a_v.map_or(0.0, |av| av[i] / g)) } else { (0.0, 0.0) }
     };
-    let rates = |i: usize| {
+    let rates = |m: &SlidingModel, i: usize| {
         let (kh, kv) = k(i);
-        (model.down.at(kh, kv), model.up.map(|u| u.at(kh, kv)))
+        (m.down.at(kh, kv), m.up.map(|u| u.at(kh, kv)))
     };
+    // lift-off is checked on the law in force after the bond is lost (if it is lost at all,
+    // that is the law of the sliding phase; the normal forces of both laws are the same).
+    let model = residual.unwrap_or(intact);
     let lift_off_samples = (0..a_h.len())
         .filter(|&i| {
             let (kh, kv) = k(i);
@@ -387,11 +419,53 @@ pub fn slide(model: &SlidingModel, a_h: &[f64], a_v: Option<&[f64]>, opts: &Newm
         if i == n - 1 {
             velocity_at_end = s.v;
         }
-        let (da, ua) = rates(i);
-        let (db, ub) = rates(i + 1);
-        s.advance(dt, da, db, ua.zip(ub));
+        match residual {
+            Some(res) if s.n_episodes == 0 => {
+                let (da, ua) = rates(intact, i);
+                let (db, ub) = rates(intact, i + 1);
+                let before = (s.v, s.d, s.mode, s.vmax);
+                s.advance(dt, da, db, ua.zip(ub));
+                if s.n_episodes > 0 {
+                    // The bond broke inside this interval: redo it, intact up to the start
+                    // time t* (at rest), then with the residual law from t*.
+                    (s.v, s.d, s.mode, s.vmax) = before;
+                    s.n_episodes = 0;
+                    s.n_up = 0;
+                    let t_star = |a: f64, b: f64, up: bool| -> Option<f64> {
+                        let (a, b) = if up { (-a, -b) } else { (a, b) };
+                        if a > 0.0 {
+                            Some(0.0)
+                        } else if b > 0.0 {
+                            Some(dt * (-a) / (b - a))
+                        } else {
+                            None
+                        }
+                    };
+                    let ts = [t_star(da, db, false), ua.zip(ub).and_then(|(x, y)| t_star(x, y, true))]
+                        .into_iter()
+                        .flatten()
+                        .fold(dt, f64::min);
+                    let (ra, rua) = rates(res, i);
+                    let (rb, rub) = rates(res, i + 1);
+                    let lerp = |a: f64, b: f64| a + (b - a) * ts / dt;
+                    let up_res = rua.zip(rub).map(|(x, y)| (lerp(x, y), y));
+                    s.advance(dt - ts, lerp(ra, rb), rb, up_res);
+                    if s.n_episodes == 0 {
+                        // round-off at t*: the residual law is weaker, so the block does start
+                        s.n_episodes = 1;
+                    }
+                }
+            }
+            _ => {
+                let m = if s.n_episodes > 0 { residual.unwrap_or(intact) } else { intact };
+                let (da, ua) = rates(m, i);
+                let (db, ub) = rates(m, i + 1);
+                s.advance(dt, da, db, ua.zip(ub));
+            }
+        }
     }
     // Free run-out with zero ground acceleration: constant r = c0.
+    let model = if s.n_episodes > 0 { residual.unwrap_or(intact) } else { intact };
     let mut still_sliding = false;
     match s.mode {
         Mode::Down if model.down.c0 < 0.0 => {

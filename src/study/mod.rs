@@ -2,4 +2,5 @@
 //! the wedge study of the seed paper. Owns no physics of its own: it varies scenes and calls the
 //! pipeline stages.
 
+pub mod rigid_level;
 pub mod ssr;
