@@ -54,6 +54,10 @@ pub struct RunSummary {
     pub equilibrium: Option<EquilibriumInfo>,
     pub energy: crate::dynamics::Energy,
     pub peak_displacement: Peak,
+    /// Peak |v| [m/s] and |a| [m/s²] of any node (relative to the base, central differences;
+    /// sampled every 10 steps, as the peak displacement).
+    pub peak_velocity: Peak,
+    pub peak_acceleration: Peak,
     pub monitors: Vec<Monitor>,
     pub frames: usize,
     pub out_dir: PathBuf,
@@ -216,6 +220,8 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         indicatif::ProgressBar::hidden()
     };
     let mut peak = Peak::default();
+    let mut peak_v = Peak::default();
+    let mut peak_a = Peak::default();
     let mut rows = vec![[0.0; 9]; monitors.len()];
     for k in 0..n_steps {
         solver.step(&model, &loads, &mut state, Stage::Dynamic, contact.as_mut().map(|c| c as &mut dyn Correction))?;
@@ -240,6 +246,17 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
                 let m2 = kin.u[3 * n].powi(2) + kin.u[3 * n + 1].powi(2) + kin.u[3 * n + 2].powi(2);
                 if m2 > peak.value * peak.value {
                     peak = Peak { value: m2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
+                }
+                let (mut v2, mut a2) = (0.0, 0.0);
+                for i in 3 * n..3 * n + 3 {
+                    v2 += ((kin.u_next[i] - kin.u_prev[i]) / (2.0 * dt)).powi(2);
+                    a2 += ((kin.u_next[i] - 2.0 * kin.u[i] + kin.u_prev[i]) / (dt * dt)).powi(2);
+                }
+                if v2 > peak_v.value * peak_v.value {
+                    peak_v = Peak { value: v2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
+                }
+                if a2 > peak_a.value * peak_a.value {
+                    peak_a = Peak { value: a2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
                 }
             }
         }
@@ -282,6 +299,8 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         equilibrium,
         energy: state.energy.clone(),
         peak_displacement: peak,
+        peak_velocity: peak_v,
+        peak_acceleration: peak_a,
         monitors,
         frames: frames.as_ref().map(|f| f.series.len()).unwrap_or(0),
         pvd: frames.as_ref().map(|f| f.series.path().to_path_buf()),
@@ -321,6 +340,7 @@ impl RunSummary {
         }
         let _ = writeln!(s, "  energy          max balance error {:.2e} of the energy scale {:.3e} J", self.energy.max_error, self.energy.scale);
         let _ = writeln!(s, "  peak |u|        {:.4e} m at t = {:.4} s, node {}", self.peak_displacement.value, self.peak_displacement.t, self.peak_displacement.node_tag);
+        let _ = writeln!(s, "  peak |v|, |a|   {:.4e} m/s (t = {:.4} s, node {}), {:.4e} m/s² (t = {:.4} s, node {})", self.peak_velocity.value, self.peak_velocity.t, self.peak_velocity.node_tag, self.peak_acceleration.value, self.peak_acceleration.t, self.peak_acceleration.node_tag);
         for m in &self.monitors {
             let _ = writeln!(s, "  monitor {:8} node {} ({:.3e} m from the requested point)", m.name, m.node_tag, m.snap_distance);
         }
