@@ -277,7 +277,8 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     bar.finish_and_clear();
     history.flush()?;
     if let Some(jw) = joint_out.as_mut() {
-        jw.write_frame(state.t, &model.joints, &state.contact, &state.u)?;
+        // the last step already wrote its frame (k + 1 == n_steps above)
+        jw.flush()?;
     }
     lap("dynamic", &mut t);
 

@@ -127,11 +127,17 @@ impl JointWriter {
         Ok(())
     }
 
-    /// Write one joint-surface frame per joint and flush the histories.
-    pub fn write_frame(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState, u: &[f64]) -> Result<(), OutputError> {
+    /// Flush the CSV histories (rows written so far reach the disk).
+    pub fn flush(&mut self) -> Result<(), OutputError> {
         for (p, w) in &mut self.csv {
             w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
         }
+        Ok(())
+    }
+
+    /// Write one joint-surface frame per joint and flush the histories.
+    pub fn write_frame(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState, u: &[f64]) -> Result<(), OutputError> {
+        self.flush()?;
         if !self.frames {
             return Ok(());
         }
