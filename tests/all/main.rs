@@ -9,5 +9,6 @@ mod contact;
 mod contact_validation;
 mod dynamics;
 mod mesh;
+mod outputs;
 mod rigid;
 mod tagging;
