@@ -313,3 +313,35 @@ fn el_centro_incline_penalty_drifts_under_dt_halving_unless_stiff() {
     assert!(e_soft > 0.5 && e_soft2 > 0.5, "soft penalty: errors {e_soft:.3}, {e_soft2:.3}");
     assert!(c_soft.abs() > 0.05 && c_soft.abs() > 50.0 * c_nts.abs(), "soft penalty dt-halving change {c_soft:.4} vs NTS {c_nts:.2e}");
 }
+
+/// Regression (found by the audit): a pair lost its bond (cohesion) when its trial gap was
+/// > 0 by round-off. At the first step of a ramped or sudden load both sides of a touching
+/// joint move together, so the trial gap is the initial gap, ±1e-16 m, and about half the pairs
+/// of a brittle cohesive joint lost their cohesion at step 0 (6 of 12 here with NTS). The
+/// penalty variant, with its own copy of the law, dropped the bond at any gap ≥ 0, i.e. every
+/// touching pair of the first step, so a brittle cohesive penalty joint had no cohesion at all
+/// (and it ignored `tied` and `tensile_strength`). Fix: opening needs a gap above the round-off
+/// of the joint's coordinates (`JointLaw::open_tolerance`), and the penalty variant uses the
+/// same law (`law::penalty_force`). Case: the incline slider (β = 30°, W = 6131 N, A = 0.5 m²),
+/// μ = 0.3, c = 10 kPa, gravity ramped in by relaxation (quasi-static, nothing opens): c A = 5 kN
+/// is 3.4 × the net driving force W (sin β − μ cos β) = 1.47 kN, so the block must stick.
+/// Reference: every bond intact and no sliding; tolerance: mean down-slope displacement below
+/// 1e-4 m over 0.3 s after relaxation (without cohesion the relaxation cannot even converge:
+/// the block slides).
+#[test]
+fn regression_bond_lost_to_a_round_off_gap_at_first_contact() {
+    for method in ["nts", "penalty"] {
+        let sc = incline_scene(json!({"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.3, "cohesion": 1e4,
+                                      "method": method, "penalty_stiffness": 1e11}), 1e10, true);
+        let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc).unwrap();
+        let pen = jointquake::contact::force::ContactSolver::new(&model, &model.joints).penalty_omega2_bound(&model);
+        let courant = 0.9 * model.stable_dt_with(pen) / model.stable_dt();
+        let steps = (0.3 / (courant * model.stable_dt())).round() as usize;
+        let (_, st) = simulate_contact(&model, &sc, courant, steps, true, |_, _| {});
+        let s = slider_mean_downslope(&model, &st.u);
+        let intact = st.contact.joints[0].pairs.iter().filter(|p| p.hist.intact).count();
+        eprintln!("{method}: down-slope displacement after {:.3} s: {s:.3e} m, {intact} of {} bonds intact", st.t, st.contact.joints[0].pairs.len());
+        assert!(s.abs() < 1e-4, "{method}: the cohesive block slid {s:.3e} m");
+        assert_eq!(intact, 12, "{method}: bonds lost without any opening or slip");
+    }
+}
