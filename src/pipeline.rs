@@ -197,6 +197,11 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mut history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
     let mut frames = if scene.output.frames { Some(FrameWriter::create(&out_dir, scene.name(), &model)?) } else { None };
     let mut joint_out = if model.joints.is_empty() { None } else { Some(JointWriter::create(&out_dir, &model.joints, scene.output.frames)?) };
+    if let (Some(jw), Some(c)) = (joint_out.as_mut(), contact.as_ref()) {
+        for (p, j) in jw.peaks.iter_mut().zip(&model.joints) {
+            p.gs_tolerance = if matches!(j.method, crate::contact::joint::Method::Penalty { .. }) { 0.0 } else { c.gs_tolerance };
+        }
+    }
     let n_steps = (scene.time.duration / dt).round() as usize;
     let frame_stride = match (scene.output.frame_stride, scene.output.frame_interval) {
         (Some(k), _) => k,
@@ -348,8 +353,8 @@ impl RunSummary {
         for j in &self.joints {
             let _ = writeln!(
                 s,
-                "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {}{}",
-                j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps,
+                "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {} (tolerance {:.1e} m){}",
+                j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps, j.gs_tolerance,
                 if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
             );
             let e = &j.events;

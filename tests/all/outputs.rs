@@ -333,13 +333,17 @@ fn joint_outputs_series_history_and_summary() {
     assert!(last[7] > 0.0 && last[9] >= 1.0 && last[10] > 0.0, "sliding pairs, Gauss–Seidel sweeps and a normal force at the end: {last:?}");
     let v: Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     let j = &v["joints"][0];
-    for k in ["name", "method", "max_opening", "max_opening_t", "max_slip", "max_tangential_displacement", "max_penetration", "max_sweeps", "unconverged_steps", "events", "ntn_max_distance"] {
+    for k in ["name", "method", "max_opening", "max_opening_t", "max_slip", "max_tangential_displacement", "max_penetration", "max_sweeps", "gs_tolerance", "unconverged_steps", "events", "ntn_max_distance"] {
         assert!(j.get(k).is_some(), "summary.json joints[0] lacks `{k}`");
     }
     for k in ["recentred", "perimeter_kept", "widened_layer2", "fresh_searches", "lost", "projection_failures"] {
         assert!(j["events"].get(k).is_some(), "events lack `{k}`");
     }
     assert!(j["max_sweeps"].as_u64().unwrap() >= 1);
+    // documented: 1e-12 × the joint size (diagonal of the bounding box of both surfaces)
+    let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &jointquake::scene::Scene::load(&p).unwrap()).unwrap();
+    let tol = 1e-12 * model.joints[0].tag.size;
+    assert!((j["gs_tolerance"].as_f64().unwrap() - tol).abs() < 1e-15 * tol, "{} vs {tol}", j["gs_tolerance"]);
     let csv_max_slip = rows.iter().map(|r| r[2]).fold(0.0, f64::max);
     assert!((j["max_slip"].as_f64().unwrap() - csv_max_slip).abs() <= 1e-9 * csv_max_slip, "{} vs {csv_max_slip}", j["max_slip"]);
     let b = 30f64.to_radians();
