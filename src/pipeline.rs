@@ -228,6 +228,21 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mut peak_v = Peak::default();
     let mut peak_a = Peak::default();
     let mut rows = vec![[0.0; 9]; monitors.len()];
+    if n_steps == 0 {
+        // `duration: 0` runs only the equilibrium: write that state (at rest) as the one frame
+        let kin = Kinematics { t: 0.0, dt, u_prev: &state.u, u: &state.u, u_next: &state.u };
+        for (r, m) in rows.iter_mut().zip(&monitors) {
+            r[..3].copy_from_slice(&kin.u[3 * m.node..3 * m.node + 3]);
+        }
+        history.row(0.0, &rows)?;
+        if let Some(f) = frames.as_mut() {
+            f.write(&model, &kin)?;
+        }
+        if let Some(jw) = joint_out.as_mut() {
+            jw.record(0.0, &model.joints, &state.contact)?;
+            jw.write_frame(0.0, &model.joints, &state.contact, &state.u)?;
+        }
+    }
     for k in 0..n_steps {
         solver.step(&model, &loads, &mut state, Stage::Dynamic, contact.as_mut().map(|c| c as &mut dyn Correction))?;
         // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt

@@ -386,3 +386,35 @@ fn regression_joint_series_repeated_its_last_frame() {
     assert_eq!(joint.len(), s.frames, "joint frames vs volume frames");
     assert!(joint.windows(2).all(|w| w[0].0 < w[1].0), "repeated joint frame time");
 }
+
+/// `duration: 0` runs only the gravity equilibrium (docs/scenes.md): the run writes that state
+/// as one frame (volume and joint series) and one history row, so the `.pvd` files the summary
+/// lists exist. Scene:
+/// pipelines/tag_boxes.json (two boxes on a non-conforming joint) with gravity added. Reference:
+/// at equilibrium the joint carries the upper box's weight ρ g V = 2400 × 9.81 × 0.5 N; tolerance
+/// 1e-3 (the relaxation stops at 1e-6 of the gravity load; measured 1e-6).
+#[test]
+fn zero_duration_writes_the_equilibrium_frame() {
+    let dir = scratch("outputs/zero_duration");
+    let mut scene: Value = serde_json::from_str(&std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/tag_boxes.json")).unwrap()).unwrap();
+    scene["geometry"]["msh"] = json!(fixture("boxes_hex_4x3.msh"));
+    scene["loads"] = json!({"gravity": {}});
+    let p = write_scene(&dir, &scene);
+    let out = dir.join("out");
+    let s = run(&p, &RunOptions { out_dir: Some(out.clone()), ..Default::default() }).unwrap();
+    assert_eq!((s.steps, s.frames), (0, 1));
+    assert!(s.pvd.as_ref().unwrap().exists() && s.joint_series.iter().all(|p| p.exists()));
+    assert_eq!(pvd_entries(&out.join("tag_boxes.pvd")).len(), 1);
+    assert_eq!(pvd_entries(&out.join("joints/J.pvd")).len(), 1);
+    let vtu = std::fs::read_to_string(out.join("joints/J_00000.vtu")).unwrap();
+    assert!(vtu.contains("Name=\"normal_traction\""));
+    let csv = std::fs::read_to_string(out.join("histories/joint_J.csv")).unwrap();
+    let row: Vec<f64> = csv.lines().nth(1).expect("one joint history row").split(',').map(|x| x.parse().unwrap()).collect();
+    let weight = 2400.0 * 9.81 * 0.5;
+    eprintln!("joint normal force at equilibrium {:.2} N, upper box weight {weight:.2} N", row[10]);
+    assert!((row[10] / weight - 1.0).abs() < 1e-3, "joint normal force {} vs weight {weight}", row[10]);
+    if let Some(py) = venv_python() {
+        let o = std::process::Command::new(py).arg(concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/check_vtu.py")).arg(&out).output().unwrap();
+        assert!(o.status.success(), "check_vtu.py:\n{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    }
+}
