@@ -418,3 +418,33 @@ fn zero_duration_writes_the_equilibrium_frame() {
         assert!(o.status.success(), "check_vtu.py:\n{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     }
 }
+
+/// The other half: on a terminal (a pseudo-terminal from util-linux `script`) the run draws its
+/// progress bar (`… steps, t = … s, eta …`), and `--quiet` suppresses it. Skipped with a note
+/// where `script` is not installed.
+#[test]
+fn progress_bar_on_a_terminal_unless_quiet() {
+    if !Path::new("/usr/bin/script").exists() {
+        eprintln!("note: /usr/bin/script absent, terminal progress bar not checked");
+        return;
+    }
+    let dir = scratch("outputs/progress_tty");
+    let scene = json!({
+        "geometry": {"msh": fixture("column_hex.msh")},
+        "materials": [{"group": "block:column", "E": 30e9, "nu": 0.2, "rho": 2400}],
+        "boundary": [{"group": "bc:base"}],
+        "time": {"duration": 20.0},
+        "output": {"frames": false}
+    });
+    write_scene(&dir, &scene);
+    let tty = |extra: &str| {
+        let cmd = format!("{} run scene.json --out out{extra}", env!("CARGO_BIN_EXE_jointquake"));
+        let o = std::process::Command::new("/usr/bin/script").args(["-qec", &cmd, "/dev/null"]).current_dir(&dir).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    let shown = tty("");
+    assert!(shown.contains(" steps, t = ") && shown.contains("eta"), "no progress bar on a terminal:\n{shown}");
+    let quiet = tty(" --quiet");
+    assert!(!quiet.contains(" steps, t = ") && quiet.contains("summary "), "--quiet still drew a bar:\n{quiet}");
+}
