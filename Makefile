@@ -46,7 +46,7 @@ demo: venv build
 	@echo "Open out/demo/$$(basename $(SCENE) .json).pvd in ParaView (File > Open, then Apply)."
 
 test: venv
-	cargo test --release
+	JQ_REQUIRE_VENV=1 cargo test --release
 	@echo "== gmsh path: mesh a .geo through the CLI and run it"
 	cargo build --release
 	$(BIN) mesh pipelines/demo.json
@@ -54,6 +54,9 @@ test: venv
 	@echo "== meshio cross-check of the demo output"
 	$(BIN) run pipelines/demo.json --out target/test-demo --quiet
 	$(PY) scripts/check_vtu.py target/test-demo
+	@echo "== meshio cross-check of a scene with a joint (joint series, joint history)"
+	$(BIN) run pipelines/impact.json --out target/test-impact --quiet
+	$(PY) scripts/check_vtu.py target/test-impact
 	@echo "make test: all checks passed"
 
 # ---- stages --------------------------------------------------------------------------

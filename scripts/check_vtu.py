@@ -4,10 +4,16 @@
 Usage: check_vtu.py OUT_DIR [--quiet]
 
 Checks: every .pvd lists files that exist; every listed VTU is read by meshio with the
-expected arrays (point data displacement/velocity/acceleration with 3 components per point;
-cell data stress 9, principal_stress 3, von_mises 1, block_id 1 for volume frames); all
-values are finite; principal stresses are ordered; the number of frames equals summary.json;
-every history CSV has rows. Exits non-zero with a message naming the file on any failure.
+expected arrays (volume frames: point data displacement/velocity/acceleration with 3
+components per point, cell data stress 9, principal_stress 3, von_mises 1, block_id 1; joint
+frames in joints/: point data displacement 3, normal 3, gap, opening, slip,
+tangential_displacement, normal_traction, shear_traction, state, tributary_area 1); all values
+are finite (except a joint's gap, NaN where a slave node found no master face); principal
+stresses are ordered; joint states are 0..3 and openings >= 0; the number of frames of the
+volume series and of every joint series equals summary.json; every history CSV has rows of
+finite numbers (monitors: the 10 columns t,u,v,a; joints: the 12 documented columns).
+Without summary.json (a killed run) the series alone are checked. Exits non-zero with a
+message naming the file on any failure.
 """
 import json
 import os
@@ -19,6 +25,11 @@ import numpy as np
 
 VOLUME_POINT = {"displacement": 3, "velocity": 3, "acceleration": 3}
 VOLUME_CELL = {"stress": 9, "principal_stress": 3, "von_mises": 1, "block_id": 1}
+JOINT_POINT = {"displacement": 3, "normal": 3, "gap": 1, "opening": 1, "slip": 1, "tangential_displacement": 1,
+               "normal_traction": 1, "shear_traction": 1, "state": 1, "tributary_area": 1}
+MONITOR_HEADER = "t,ux,uy,uz,vx,vy,vz,ax,ay,az"
+JOINT_HEADER = ("t,max_opening,max_slip,max_tangential_displacement,max_penetration,open,stick,slip,bonded,"
+                "sweeps,normal_force,shear_force")
 
 
 def fail(msg):
@@ -53,6 +64,40 @@ def check_volume(path, m):
         fail(f"{path}: principal stresses not ordered s1 >= s2 >= s3")
 
 
+def check_joint(path, m):
+    for name, k in JOINT_POINT.items():
+        if name not in m.point_data:
+            fail(f"{path}: point array {name} missing (has {list(m.point_data)})")
+        a = np.asarray(m.point_data[name])
+        if a.shape[0] != len(m.points) or ncomp(a) != k:
+            fail(f"{path}: point array {name} has shape {a.shape}, expected ({len(m.points)}, {k})")
+        if name != "gap" and not np.all(np.isfinite(a)):
+            fail(f"{path}: point array {name} has non-finite values")
+    state = np.asarray(m.point_data["state"]).ravel()
+    if np.any((state < 0) | (state > 3)):
+        fail(f"{path}: joint state outside 0..3")
+    if np.any(np.asarray(m.point_data["opening"]) < 0):
+        fail(f"{path}: negative opening")
+    if np.any(np.asarray(m.point_data["tributary_area"]) <= 0):
+        fail(f"{path}: non-positive tributary area")
+
+
+def check_history(h):
+    lines = [l.rstrip("\n") for l in open(h)]
+    joint = os.path.basename(h).startswith("joint_")
+    header, ncol = (JOINT_HEADER, 12) if joint else (MONITOR_HEADER, 10)
+    if header not in lines:
+        fail(f"{h}: header line {header!r} missing")
+    rows = lines[lines.index(header) + 1:]
+    if not rows:
+        fail(f"{h}: no rows")
+    a = np.loadtxt(h, delimiter=",", comments=["#", "t,"], ndmin=2)
+    if a.shape[1] != ncol or not np.all(np.isfinite(a)):
+        fail(f"{h}: expected {ncol} finite columns, got shape {a.shape}")
+    if joint and np.any(a[:, 5:9].sum(axis=1) != a[0, 5:9].sum()):
+        fail(f"{h}: pairs per state do not add up to the same number of slave nodes on every row")
+
+
 def main():
     if len(sys.argv) < 2:
         fail("usage: check_vtu.py OUT_DIR [--quiet]")
@@ -83,24 +128,24 @@ def main():
                 fail(f"{f}: no points")
             if os.path.dirname(pvd) == out.rstrip("/") or os.path.dirname(pvd) == out:
                 check_volume(f, m)
+            else:
+                check_joint(f, m)
         total += len(sets)
         if not quiet:
             print(f"check_vtu: {pvd}: {len(sets)} frames read by meshio, arrays and shapes OK")
     sj = os.path.join(out, "summary.json")
     if os.path.exists(sj):
         s = json.load(open(sj))
-        main_pvd = [p for p in pvds if os.path.dirname(p) == out.rstrip("/")]
-        if main_pvd:
-            n = len(ET.parse(main_pvd[0]).getroot().findall("./Collection/DataSet"))
+        # the volume series and every joint series have one frame per output step
+        for p in pvds:
+            n = len(ET.parse(p).getroot().findall("./Collection/DataSet"))
             if n != s["frames"]:
-                fail(f"{main_pvd[0]}: {n} frames but summary.json says {s['frames']}")
+                fail(f"{p}: {n} frames but summary.json says {s['frames']}")
+        for p in s.get("joint_series", []):
+            if s["frames"] > 0 and not os.path.exists(p):
+                fail(f"summary.json lists the joint series {p}, which does not exist")
         for h in s.get("histories", []):
-            rows = [l for l in open(h) if l and l[0] not in "#t"]
-            if not rows:
-                fail(f"{h}: no rows")
-            a = np.loadtxt(h, delimiter=",", comments=["#", "t,"])
-            if a.ndim != 2 or a.shape[1] != 10 or not np.all(np.isfinite(a)):
-                fail(f"{h}: expected 10 finite columns, got shape {a.shape}")
+            check_history(h)
     print(f"check_vtu: {len(pvds)} series, {total} VTU files OK ({out})")
 
 

@@ -54,6 +54,10 @@ pub struct RunSummary {
     pub equilibrium: Option<EquilibriumInfo>,
     pub energy: crate::dynamics::Energy,
     pub peak_displacement: Peak,
+    /// Peak |v| [m/s] and |a| [m/s²] of any node (relative to the base, central differences;
+    /// sampled every 10 steps, as the peak displacement).
+    pub peak_velocity: Peak,
+    pub peak_acceleration: Peak,
     pub monitors: Vec<Monitor>,
     pub frames: usize,
     pub out_dir: PathBuf,
@@ -199,6 +203,11 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mut history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
     let mut frames = if scene.output.frames { Some(FrameWriter::create(&out_dir, scene.name(), &model)?) } else { None };
     let mut joint_out = if model.joints.is_empty() { None } else { Some(JointWriter::create(&out_dir, &model.joints, scene.output.frames)?) };
+    if let (Some(jw), Some(c)) = (joint_out.as_mut(), contact.as_ref()) {
+        for (p, j) in jw.peaks.iter_mut().zip(&model.joints) {
+            p.gs_tolerance = if matches!(j.method, crate::contact::joint::Method::Penalty { .. }) { 0.0 } else { c.gs_tolerance };
+        }
+    }
     let n_steps = (scene.time.duration / dt).round() as usize;
     let frame_stride = match (scene.output.frame_stride, scene.output.frame_interval) {
         (Some(k), _) => k,
@@ -222,7 +231,24 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         indicatif::ProgressBar::hidden()
     };
     let mut peak = Peak::default();
+    let mut peak_v = Peak::default();
+    let mut peak_a = Peak::default();
     let mut rows = vec![[0.0; 9]; monitors.len()];
+    if n_steps == 0 {
+        // `duration: 0` runs only the equilibrium: write that state (at rest) as the one frame
+        let kin = Kinematics { t: 0.0, dt, u_prev: &state.u, u: &state.u, u_next: &state.u };
+        for (r, m) in rows.iter_mut().zip(&monitors) {
+            r[..3].copy_from_slice(&kin.u[3 * m.node..3 * m.node + 3]);
+        }
+        history.row(0.0, &rows)?;
+        if let Some(f) = frames.as_mut() {
+            f.write(&model, &kin)?;
+        }
+        if let Some(jw) = joint_out.as_mut() {
+            jw.record(0.0, &model.joints, &state.contact)?;
+            jw.write_frame(0.0, &model.joints, &state.contact, &state.u)?;
+        }
+    }
     for k in 0..n_steps {
         solver.step(&model, &loads, &mut state, Stage::Dynamic, contact.as_mut().map(|c| c as &mut dyn Correction))?;
         // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt
@@ -247,6 +273,17 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
                 if m2 > peak.value * peak.value {
                     peak = Peak { value: m2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
                 }
+                let (mut v2, mut a2) = (0.0, 0.0);
+                for i in 3 * n..3 * n + 3 {
+                    v2 += ((kin.u_next[i] - kin.u_prev[i]) / (2.0 * dt)).powi(2);
+                    a2 += ((kin.u_next[i] - 2.0 * kin.u[i] + kin.u_prev[i]) / (dt * dt)).powi(2);
+                }
+                if v2 > peak_v.value * peak_v.value {
+                    peak_v = Peak { value: v2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
+                }
+                if a2 > peak_a.value * peak_a.value {
+                    peak_a = Peak { value: a2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
+                }
             }
         }
         if k % frame_stride == 0 || k + 1 == n_steps {
@@ -266,7 +303,8 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     bar.finish_and_clear();
     history.flush()?;
     if let Some(jw) = joint_out.as_mut() {
-        jw.write_frame(state.t, &model.joints, &state.contact, &state.u)?;
+        // the last step already wrote its frame (k + 1 == n_steps above)
+        jw.flush()?;
     }
     lap("dynamic", &mut t);
 
@@ -288,6 +326,8 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         equilibrium,
         energy: state.energy.clone(),
         peak_displacement: peak,
+        peak_velocity: peak_v,
+        peak_acceleration: peak_a,
         monitors,
         frames: frames.as_ref().map(|f| f.series.len()).unwrap_or(0),
         pvd: frames.as_ref().map(|f| f.series.path().to_path_buf()),
@@ -327,14 +367,15 @@ impl RunSummary {
         }
         let _ = writeln!(s, "  energy          max balance error {:.2e} of the energy scale {:.3e} J", self.energy.max_error, self.energy.scale);
         let _ = writeln!(s, "  peak |u|        {:.4e} m at t = {:.4} s, node {}", self.peak_displacement.value, self.peak_displacement.t, self.peak_displacement.node_tag);
+        let _ = writeln!(s, "  peak |v|, |a|   {:.4e} m/s (t = {:.4} s, node {}), {:.4e} m/s² (t = {:.4} s, node {})", self.peak_velocity.value, self.peak_velocity.t, self.peak_velocity.node_tag, self.peak_acceleration.value, self.peak_acceleration.t, self.peak_acceleration.node_tag);
         for m in &self.monitors {
             let _ = writeln!(s, "  monitor {:8} node {} ({:.3e} m from the requested point)", m.name, m.node_tag, m.snap_distance);
         }
         for j in &self.joints {
             let _ = writeln!(
                 s,
-                "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {}{}",
-                j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps,
+                "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {} (tolerance {:.1e} m){}",
+                j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps, j.gs_tolerance,
                 if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
             );
             let e = &j.events;

@@ -16,12 +16,13 @@
 //! node does not move under contact forces; free components of partly fixed nodes are treated
 //! as fixed for the pair mobility, and the correction is applied to free components only).
 //!
-//! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal force
-//! kn A max(0, −g), tangential elastic spring kt A with the same Mohr-Coulomb cap, applied as an
+//! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal spring
+//! kn A on the gap, tangential elastic spring kt A, with the joint law of the dynamic contact
+//! force ([`super::law::penalty_force`]: Mohr-Coulomb, cohesion, tension, tied), applied as an
 //! external force of step n (so it is explicit and lowers the stable step).
 
 use super::joint::{ContactJoint, Method, OnExit};
-use super::law::{pair_force, JointLaw, PairHistory, PairState};
+use super::law::{pair_force, penalty_force, JointLaw, PairHistory, PairState};
 use super::query::{select_projection, INSIDE_TOL_DEFAULT};
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
@@ -186,6 +187,11 @@ impl<'m> ContactSolver<'m> {
             }
         }
         row.into_iter().fold(0.0, f64::max)
+    }
+
+    /// The joint's law as it applies now: with [`Self::keep_bonds`] its bond is kept.
+    fn law_in_force(&self, j: &ContactJoint) -> JointLaw {
+        if self.keep_bonds { JointLaw { keep_cohesion: true, ..j.law } } else { j.law }
     }
 
     fn candidates_into(&mut self, j: &ContactJoint, center: u32, layer: u8) {
@@ -421,26 +427,10 @@ impl Correction for ContactSolver<'_> {
                     let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
                     let area = j.tag.areas[i];
                     let p = &mut rec.pairs[i];
-                    let (r_n, r_t, state) = if gap < 0.0 {
-                        let r_n = kn * area * (-gap);
-                        let mut rt = Vector2::new(p.r_t[0], p.r_t[1]) - kt * area * Vector2::new(dd.dot(&t1), dd.dot(&t2));
-                        let coh = if p.hist.intact { j.law.cohesion * area } else { 0.0 };
-                        let lim = j.law.mu * r_n + coh;
-                        let mut state = PairState::Stick;
-                        if rt.norm() > lim {
-                            rt *= lim / rt.norm();
-                            state = PairState::Slip;
-                            if !j.law.keep_cohesion {
-                                p.hist.intact = false;
-                            }
-                        }
-                        (r_n, rt, state)
-                    } else {
-                        if !j.law.keep_cohesion {
-                            p.hist.intact = false;
-                        }
-                        (0.0, Vector2::zeros(), PairState::Open)
-                    };
+                    let ddt = Vector2::new(dd.dot(&t1), dd.dot(&t2));
+                    let resp = penalty_force(&self.law_in_force(j), &p.hist, gap, Vector2::new(p.r_t[0], p.r_t[1]), ddt, kn * area, kt * area, area);
+                    p.hist = resp.hist;
+                    let (r_n, r_t, state) = (resp.r_n, resp.r_t, resp.state);
                     let rvec = -n * r_n + t1 * r_t.x + t2 * r_t.y;
                     p.d_t[0] += dd.dot(&t1);
                     p.d_t[1] += dd.dot(&t2);
@@ -531,12 +521,7 @@ impl Correction for ContactSolver<'_> {
                 // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
                 let g_trial = g_cur - a.dt2w * a.r_n;
                 let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-                let resp = if self.keep_bonds && !j.law.keep_cohesion {
-                    let kept = JointLaw { keep_cohesion: true, ..j.law };
-                    pair_force(&kept, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i])
-                } else {
-                    pair_force(&j.law, &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i])
-                };
+                let resp = pair_force(&self.law_in_force(j), &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i]);
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
                 self.counter += 1;

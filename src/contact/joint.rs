@@ -1,7 +1,7 @@
 //! A joint ready for contact mechanics: the tagged interface, its law, method and options.
 //! Built once with the model, never mutated.
 
-use super::law::JointLaw;
+use super::law::{JointLaw, OPEN_TOLERANCE_RELATIVE};
 use crate::error::{Error, ModelError};
 use crate::interface::{tag_joint, Joint, JointSpec};
 use crate::mesh::Mesh;
@@ -70,12 +70,13 @@ impl ContactJoint {
             (None, Some(p)) => p.to_radians().tan(),
             (None, None) => 0.6,
         };
-        let law = JointLaw {
+        let mut law = JointLaw {
             mu,
             cohesion: spec.cohesion.unwrap_or(0.0),
             tensile_strength: spec.tensile_strength.unwrap_or(0.0),
             keep_cohesion: spec.keep_cohesion.unwrap_or(false),
             tied: spec.tied.unwrap_or(false),
+            open_tolerance: 0.0,
         };
         law.validate().map_err(|e| bad(e.to_string()))?;
         let method = match spec.method.as_deref().unwrap_or("nts") {
@@ -106,6 +107,9 @@ impl ContactJoint {
         let tol = spec.tolerance.unwrap_or(1e-6 * model_size);
         let js = JointSpec { name: spec.name.clone(), master: spec.master.clone(), slave: spec.slave.clone(), auto: spec.auto };
         let tag = tag_joint(mesh, &js, tol)?;
+        // a pair "opens" (and loses its bond) only beyond the round-off of its gap
+        let coord = tag.slave.nodes.iter().chain(&tag.master.nodes).flat_map(|&n| mesh.nodes[n]).fold(0.0f64, |m, x| m.max(x.abs()));
+        law.open_tolerance = OPEN_TOLERANCE_RELATIVE * (coord + tag.size);
         let frames = tag
             .normals
             .iter()

@@ -56,12 +56,24 @@ pub struct JointLaw {
     /// Default false. Used for non-conforming glued blocks (dam on foundation).
     #[serde(default)]
     pub tied: bool,
+    /// Gap (m) a pair must exceed to count as *opened* for the loss of its bond. Default 0 in
+    /// the pure law; `ContactJoint::build` sets it to the round-off of the joint's positions
+    /// ([`OPEN_TOLERANCE_RELATIVE`] × its coordinate scale), so that a pair touching to
+    /// round-off keeps its bond: at the first step of a suddenly loaded joint both sides move
+    /// together and the trial gap is the initial gap, ±1e-16 m, whose sign is noise.
+    #[serde(default)]
+    pub open_tolerance: f64,
 }
+
+/// Round-off scale of a gap, relative to the largest coordinate magnitude of the joint (plus
+/// its size): 1e-12, about 5000 × the double-precision epsilon, so far above the round-off of
+/// n · (x̄ − x_s) and far below any physical opening.
+pub const OPEN_TOLERANCE_RELATIVE: f64 = 1e-12;
 
 impl JointLaw {
     /// Pure Coulomb friction μ: no cohesion, no tension, brittle defaults.
     pub fn coulomb(mu: f64) -> Self {
-        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false }
+        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false, open_tolerance: 0.0 }
     }
 
     /// A glued (tied) interface.
@@ -72,7 +84,7 @@ impl JointLaw {
     /// Check that every parameter is finite and non-negative; the error names the field.
     pub fn validate(&self) -> Result<(), JointLawError> {
         for (field, value) in
-            [("mu", self.mu), ("cohesion", self.cohesion), ("tensile_strength", self.tensile_strength)]
+            [("mu", self.mu), ("cohesion", self.cohesion), ("tensile_strength", self.tensile_strength), ("open_tolerance", self.open_tolerance)]
         {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(JointLawError { field, value });
@@ -85,7 +97,7 @@ impl JointLaw {
 /// An invalid joint-law parameter.
 #[derive(Clone, Debug, PartialEq, Error)]
 #[error(
-    "joint law: `{field}` = {value} must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa)"
+    "joint law: `{field}` = {value} must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa, open_tolerance in m)"
 )]
 pub struct JointLawError {
     pub field: &'static str,
@@ -188,7 +200,7 @@ pub fn pair_force(
     }
     let bonded = hist.intact && law.tensile_strength > 0.0;
     if g_trial >= 0.0 && !bonded {
-        let opened = g_trial > 0.0;
+        let opened = g_trial > law.open_tolerance;
         let intact = hist.intact && (law.keep_cohesion || !opened);
         return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
     }
@@ -222,6 +234,63 @@ pub fn pair_force(
     }
 }
 
+/// The penalty variant's pair force: springs instead of the dynamic contact force, with the
+/// decisions and strength of [`pair_force`] in the same order (tied; bonded or open; tensile
+/// rupture; Mohr-Coulomb with cohesion while intact; bond lost at the first slip or opening
+/// beyond `open_tolerance`, unless `keep_cohesion`).
+///
+/// - `gap`: the gap g (m) at t[n], positive open; the normal spring gives `r_n = −kn_a g`.
+/// - `r_t_prev`: the tangential spring force of the previous step (N, `(t1, t2)`; 0 after an
+///   open step); `dd_t`: the tangential relative displacement increment of the last step (m).
+///   Trial `r_t = r_t_prev − kt_a dd_t`, scaled back to the limit in slip.
+/// - `kn_a`, `kt_a`: the pair's spring stiffnesses (N/m: stiffness per unit area × `area`).
+///
+/// `slip_increment` is `dd_t` (the springs let a sticking pair move elastically).
+#[allow(clippy::too_many_arguments)]
+pub fn penalty_force(
+    law: &JointLaw,
+    hist: &PairHistory,
+    gap: f64,
+    r_t_prev: Vector2<f64>,
+    dd_t: Vector2<f64>,
+    kn_a: f64,
+    kt_a: f64,
+    area: f64,
+) -> PairResponse {
+    let r_trial = r_t_prev - dd_t * kt_a;
+    if law.tied {
+        return PairResponse { r_n: -kn_a * gap, r_t: r_trial, state: PairState::Bonded, hist: *hist, slip_increment: dd_t };
+    }
+    let bonded = hist.intact && law.tensile_strength > 0.0;
+    if gap >= 0.0 && !bonded {
+        let opened = gap > law.open_tolerance;
+        let intact = hist.intact && (law.keep_cohesion || !opened);
+        return PairResponse::open(PairHistory { intact, ..*hist }, dd_t);
+    }
+    let r_n = -kn_a * gap;
+    if r_n < -law.tensile_strength * area {
+        return PairResponse::open(PairHistory { intact: false, ..*hist }, dd_t);
+    }
+    let cohesion = if hist.intact { law.cohesion * area } else { 0.0 };
+    let limit = (law.mu * r_n + cohesion).max(0.0);
+    let r_trial_norm = r_trial.norm();
+    if r_trial_norm <= limit {
+        let state = if bonded { PairState::Bonded } else { PairState::Stick };
+        return PairResponse { r_n, r_t: r_trial, state, hist: *hist, slip_increment: dd_t };
+    }
+    let intact = hist.intact && law.keep_cohesion;
+    if hist.intact && !intact && r_n < 0.0 {
+        return PairResponse::open(PairHistory { intact, ..*hist }, dd_t);
+    }
+    PairResponse {
+        r_n,
+        r_t: r_trial * (limit / r_trial_norm),
+        state: PairState::Slip,
+        hist: PairHistory { intact, slip: hist.slip + dd_t.norm() },
+        slip_increment: dd_t,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -232,7 +301,7 @@ mod tests {
     const AREA: f64 = 0.25;
 
     fn law(mu: f64, c: f64, st: f64) -> JointLaw {
-        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false }
+        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false, open_tolerance: 0.0 }
     }
 
     #[test]
@@ -387,5 +456,62 @@ mod tests {
         assert_eq!(l, JointLaw::coulomb(0.6));
         assert!(serde_json::from_str::<JointLaw>(r#"{"mu": 0.6, "cohesoin": 1}"#).is_err());
         assert_eq!(serde_json::to_string(&PairState::Slip).unwrap(), "\"slip\"");
+    }
+
+    #[test]
+    fn a_round_off_gap_does_not_open_the_bond() {
+        // A trial gap below `open_tolerance` carries no force but keeps the bond; above it, it opens.
+        let l = JointLaw { open_tolerance: 1e-12, ..law(0.5, 1e5, 0.0) };
+        let r = pair_force(&l, &PairHistory::default(), 6e-16, Vector2::zeros(), DT2W, AREA);
+        assert_eq!((r.state, r.hist.intact), (PairState::Open, true));
+        let r = pair_force(&l, &PairHistory::default(), 2e-12, Vector2::zeros(), DT2W, AREA);
+        assert_eq!((r.state, r.hist.intact), (PairState::Open, false));
+        let p = penalty_force(&l, &PairHistory::default(), 6e-16, Vector2::zeros(), Vector2::zeros(), 1e9, 1e9, AREA);
+        assert_eq!((p.state, p.hist.intact), (PairState::Open, true));
+        let p = penalty_force(&l, &PairHistory::default(), 0.0, Vector2::zeros(), Vector2::zeros(), 1e9, 1e9, AREA);
+        assert!(p.hist.intact, "an exactly touching penalty pair keeps its bond");
+        let p = penalty_force(&l, &PairHistory::default(), 2e-12, Vector2::zeros(), Vector2::zeros(), 1e9, 1e9, AREA);
+        assert!(!p.hist.intact);
+    }
+
+    #[test]
+    fn penalty_springs_follow_the_same_law() {
+        // kn A = kt A = 1e9 N/m on a penetration of 1e-6 m: r_n = 1e3 N; the cap μ r_n + c A as in
+        // `pair_force`, reached along the trial direction; cohesion lost on the first slip.
+        let (ka, g) = (1e9, -1e-6);
+        let l = law(0.5, 1e3, 0.0); // c A = 250 N, limit 750 N
+        let stick = penalty_force(&l, &PairHistory::default(), g, Vector2::zeros(), Vector2::new(-5e-7, 0.0), ka, ka, AREA);
+        assert_eq!(stick.state, PairState::Stick);
+        assert!((stick.r_n - 1e3).abs() < 1e-9 && (stick.r_t - Vector2::new(500.0, 0.0)).norm() < 1e-9);
+        assert!(stick.hist.intact);
+        let slip = penalty_force(&l, &PairHistory::default(), g, Vector2::new(500.0, 0.0), Vector2::new(0.0, -1e-6), ka, ka, AREA);
+        assert_eq!(slip.state, PairState::Slip);
+        assert!((slip.r_t.norm() - 750.0).abs() < 1e-9, "{}", slip.r_t.norm());
+        let dir = Vector2::new(500.0, 1000.0).normalize();
+        assert!((slip.r_t.normalize() - dir).norm() < 1e-12, "back to the limit along the trial force");
+        assert!(!slip.hist.intact && slip.hist.slip > 0.0);
+        // without the bond the limit is μ r_n only
+        let again = penalty_force(&l, &slip.hist, g, slip.r_t, Vector2::zeros(), ka, ka, AREA);
+        assert!((again.r_t.norm() - 500.0).abs() < 1e-9);
+        // an open pair carries nothing
+        let open = penalty_force(&l, &PairHistory::default(), 1e-6, Vector2::new(100.0, 0.0), Vector2::zeros(), ka, ka, AREA);
+        assert_eq!((open.state, open.r_n, open.r_t), (PairState::Open, 0.0, Vector2::zeros()));
+    }
+
+    #[test]
+    fn penalty_tension_and_tied() {
+        let ka = 1e9;
+        // σ_t A = 1e6 × 0.25 = 2.5e5 N: a bonded pair 1e-4 m open carries 1e5 N of tension ...
+        let l = law(0.6, 0.0, 1e6);
+        let r = penalty_force(&l, &PairHistory::default(), 1e-4, Vector2::zeros(), Vector2::zeros(), ka, ka, AREA);
+        assert_eq!(r.state, PairState::Bonded);
+        assert!((r.r_n + 1e5).abs() < 1e-6);
+        // ... and at 3e-4 m (3e5 N > σ_t A) it ruptures and opens for good
+        let r = penalty_force(&l, &PairHistory::default(), 3e-4, Vector2::zeros(), Vector2::zeros(), ka, ka, AREA);
+        assert_eq!((r.state, r.hist.intact), (PairState::Open, false));
+        // tied: both signs, no shear limit
+        let t = penalty_force(&JointLaw::tied(), &PairHistory::default(), 1e-3, Vector2::zeros(), Vector2::new(1.0, 0.0), ka, ka, AREA);
+        assert_eq!(t.state, PairState::Bonded);
+        assert!((t.r_n + 1e6).abs() < 1e-6 && (t.r_t.x + 1e9).abs() < 1e-3);
     }
 }

@@ -1,7 +1,8 @@
 //! Acceleration records: reading, checking, scaling. The one place where g becomes m/s².
 //!
 //! Formats: two-column text (t [s], a [g]; `#` starts a comment; blank lines ignored) and
-//! PEER NGA `.AT2` (4 header lines, `NPTS=…, DT=…` on the 4th, then values in g, several per line).
+//! PEER `.AT2` (4 header lines, `NPTS=…, DT=…` on the 4th as in NGA files, or `N DT NPTS, DT` as in
+//! the older PEER database; then values in g, several per line).
 //! Time steps must be uniform (relative tolerance 1e-6 of dt), times increasing, values finite:
 //! anything else is an error naming the line.
 
@@ -124,8 +125,19 @@ fn parse_at2(text: &str, path: &Path) -> Result<Record, RecordError> {
         let end = rest.find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == '+' || c == 'E')).unwrap_or(rest.len());
         rest[..end].parse().ok()
     };
-    let npts = field("NPTS").ok_or_else(|| line_err(path, 4, "header line 4 has no NPTS="))? as usize;
-    let dt = field("DT").ok_or_else(|| line_err(path, 4, "header line 4 has no DT="))?;
+    // NGA format: `NPTS=  5000, DT=   .0050 SEC`; the older PEER database format puts the two
+    // numbers first: `  3930    0.01000    NPTS, DT`
+    let leading: Vec<f64> = h.split(|c: char| c.is_whitespace() || c == ',').filter(|w| !w.is_empty()).map_while(|w| w.parse().ok()).collect();
+    let (npts, dt) = if !h.contains("NPTS=") && h.contains("NPTS") && leading.len() >= 2 {
+        (leading[0], leading[1])
+    } else {
+        let npts = field("NPTS").ok_or_else(|| line_err(path, 4, "header line 4 has no NPTS= (nor `NPTS DT` after the two numbers)"))?;
+        (npts, field("DT").ok_or_else(|| line_err(path, 4, "header line 4 has no DT="))?)
+    };
+    if !(npts >= 1.0 && npts.fract() == 0.0) {
+        return Err(line_err(path, 4, format!("NPTS = {npts} must be a positive whole number")));
+    }
+    let npts = npts as usize;
     if !(dt > 0.0 && dt.is_finite()) {
         return Err(line_err(path, 4, format!("DT = {dt} must be positive")));
     }
@@ -195,6 +207,15 @@ mod tests {
         assert_eq!(r.accel.len(), 5);
         assert!((r.dt - 0.01).abs() < 1e-15);
         assert!((r.accel[4] - 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn at2_old_peer_header_reads() {
+        // the pre-NGA PEER database layout: `NPTS DT` after the two numbers on line 4
+        let p = write("old.at2", "PEER STRONG MOTION DATABASE RECORD\nx\nACCELERATION TIME HISTORY IN UNITS OF G\n    4    0.00500    NPTS, DT\n .1 -.2\n .3E+00 -4.0E-01\n");
+        let r = Record::read(&p, 1.0).unwrap();
+        assert_eq!(r.accel, vec![0.1, -0.2, 0.3, -0.4]);
+        assert!((r.dt - 0.005).abs() < 1e-15);
     }
 
     #[test]

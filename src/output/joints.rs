@@ -35,6 +35,9 @@ pub struct JointPeaks {
     /// Largest penetration (−gap) seen at the end of a step [m].
     pub max_penetration: f64,
     pub max_sweeps: usize,
+    /// Gauss–Seidel tolerance on the largest gap change of a sweep [m] (0 for penalty joints, which
+    /// are not iterated), and the steps that did not reach it within the sweep budget.
+    pub gs_tolerance: f64,
     pub unconverged_steps: u64,
     pub events: crate::contact::force::SearchEvents,
     /// Largest slave-to-O distance (the NTN geometric error) [m].
@@ -127,11 +130,17 @@ impl JointWriter {
         Ok(())
     }
 
-    /// Write one joint-surface frame per joint and flush the histories.
-    pub fn write_frame(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState, u: &[f64]) -> Result<(), OutputError> {
+    /// Flush the CSV histories (rows written so far reach the disk).
+    pub fn flush(&mut self) -> Result<(), OutputError> {
         for (p, w) in &mut self.csv {
             w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
         }
+        Ok(())
+    }
+
+    /// Write one joint-surface frame per joint and flush the histories.
+    pub fn write_frame(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState, u: &[f64]) -> Result<(), OutputError> {
+        self.flush()?;
         if !self.frames {
             return Ok(());
         }

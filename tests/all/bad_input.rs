@@ -261,3 +261,73 @@ fn material_on_a_face_group_says_a_volume_group_is_needed() {
     let msg = run_error("material_on_faces", &s);
     assert_mentions(&msg, &["\"bc:base\" has dimension 2", "a volume group (tet4/hex8 elements) of dimension 3 is needed", "\"block:column\" (dim 3)"]);
 }
+
+#[test]
+fn record_with_non_monotonic_time_names_the_line() {
+    // the fourth sample (line 4) goes back in time
+    let (msg, rec) = record_error("backwards_record", "0 0\n0.01 0.1\n0.02 0.2\n0.015 0\n");
+    assert_mentions(&msg, &[&rec.display().to_string(), "line 4", "time 0.015 does not increase", "previous 0.02"]);
+}
+
+#[test]
+fn record_with_a_text_value_names_the_line_and_value() {
+    let (msg, rec) = record_error("text_record", "0 0\n0.01 O.1\n");
+    assert_mentions(&msg, &[&rec.display().to_string(), "line 2", "acceleration `O.1` is not a number"]);
+}
+
+/// A PEER AT2 record through a whole scene: read (NGA header), scaled, and quoted in the notes.
+/// Reference: the file's own 5 values and DT; `pga` 0.5 over the file's peak 0.4 g.
+#[test]
+fn peer_at2_record_runs_through_a_scene() {
+    let dir = scratch("bad_input/at2_ok");
+    let rec = dir.join("RSN1_TEST.AT2");
+    std::fs::write(&rec, "PEER NGA STRONG MOTION DATABASE RECORD\nTEST 1/1/2000, STATION, 000\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS=    5, DT=   .0100 SEC\n  .1000000E+00 -.4000000E+00  .2000000E+00\n  .0000000E+00  .1000000E+00\n").unwrap();
+    let mut s = column_scene();
+    s["loads"] = json!({"base": [{"record": rec, "direction": [0, 1, 0], "pga": 0.5}]});
+    let p = dir.join("scene.json");
+    std::fs::write(&p, s.to_string()).unwrap();
+    let summary = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).expect("the AT2 scene runs");
+    assert!(summary.notes.iter().any(|n| n.contains("RSN1_TEST.AT2: 5 samples, dt 0.01 s, PGA 0.4000 g × 1.2500")), "{:?}", summary.notes);
+}
+
+/// A bad AT2 file: a value that is not a number or not finite names the line (header lines
+/// count: data start on line 5), and a sample count that differs from NPTS gives both counts.
+#[test]
+fn peer_at2_record_errors_name_the_line_or_the_counts() {
+    let head = "PEER NGA STRONG MOTION DATABASE RECORD\nx\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS=    4, DT=   .0100 SEC\n";
+    for (test, body, parts) in [
+        ("at2_nan", "  .1 .2\n  NaN .3\n", vec!["line 6", "non-finite value `NaN`"]),
+        ("at2_text", "  .1 .2\n  .3 x.4\n", vec!["line 6", "`x.4` is not a number"]),
+        ("at2_count", "  .1 .2 .3\n", vec!["NPTS = 4 but 3 values"]),
+    ] {
+        let dir = scratch(&format!("bad_input/{test}"));
+        let rec = dir.join("r.at2");
+        std::fs::write(&rec, format!("{head}{body}")).unwrap();
+        let mut s = column_scene();
+        s["loads"] = json!({"base": [{"record": rec, "direction": [1, 0, 0]}]});
+        let p = dir.join("scene.json");
+        std::fs::write(&p, s.to_string()).unwrap();
+        let msg = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap_err().to_string();
+        let mut all = vec![rec.display().to_string()];
+        all.extend(parts.iter().map(|x| x.to_string()));
+        assert_mentions(&msg, &all.iter().map(String::as_str).collect::<Vec<_>>());
+    }
+}
+
+#[test]
+fn unsupported_element_type_is_named() {
+    // one 6-node prism (Gmsh type 6) in a volume group: jointquake reads tet4/hex8 only
+    let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n\
+        $PhysicalNames\n1\n3 1 \"block:p\"\n$EndPhysicalNames\n\
+        $Entities\n0 0 0 1\n1 0 0 0 1 1 1 1 1 0\n$EndEntities\n\
+        $Nodes\n1 6 1 6\n3 1 0 6\n1\n2\n3\n4\n5\n6\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 1\n0 1 1\n$EndNodes\n\
+        $Elements\n1 1 1 1\n3 1 6 1\n7 1 2 3 4 5 6\n$EndElements\n";
+    let dir = scratch("bad_input/prism");
+    let msh = dir.join("prism.msh");
+    std::fs::write(&msh, text).unwrap();
+    let mut s = column_scene();
+    s["geometry"]["msh"] = json!(msh);
+    s["materials"][0]["group"] = json!("block:p");
+    let msg = run_error("prism_run", &s);
+    assert_mentions(&msg, &["prism.msh", "element 7", "unsupported type", "tet4 and hex8"]);
+}

@@ -9,6 +9,7 @@ mod contact;
 mod contact_validation;
 mod dynamics;
 mod mesh;
+mod outputs;
 mod report;
 mod rigid;
 mod tagging;
