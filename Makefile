@@ -10,11 +10,11 @@ GMSH_RUN  := $(CURDIR)/$(VENV)/bin/gmsh-run
 GMSH      ?= $(GMSH_RUN)
 export GMSH
 BIN       := target/release/jointquake
-SCENE     ?= pipelines/demo.json
+SCENE     ?= pipelines/column.json
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures
+.PHONY: demo test venv build mesh run bench clean fixtures wedge wedge-report
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -40,19 +40,30 @@ build:
 
 # ---- the two commands ----------------------------------------------------------------
 demo: venv build
-	@$(BIN) run $(SCENE) --out out/demo
+	@echo "== limit equilibrium of the seed wedge (Hoek & Bray)"
+	@$(BIN) wedge-fs
+	@echo
+	@echo "== the wedge at 1.0 g (El Centro NS + 2/3 vertical), node-to-segment contact"
+	@$(BIN) run pipelines/wedge.json --out out/demo
+	@$(BIN) study chart $(STUDY) --scene pipelines/wedge.json --run out/demo
 	@$(PY) scripts/check_vtu.py out/demo --quiet
 	@echo
-	@echo "Open out/demo/$$(basename $(SCENE) .json).pvd in ParaView (File > Open, then Apply)."
+	@echo "ParaView: open out/demo/wedge.pvd (the blocks) and out/demo/joints/A.pvd, B.pvd (joint surfaces: gap, slip, state),"
+	@echo "          File > Open, then Apply. Histories: out/demo/histories/*.csv. Charts: out/demo/charts/*.png (.svg)."
+	@echo "The whole study (PGA sweep, NTS/NTN/rigid, speed against accuracy, report): make wedge"
 
 test: venv
 	JQ_REQUIRE_VENV=1 cargo test --release
 	@echo "== gmsh path: mesh a .geo through the CLI and run it"
 	cargo build --release
-	$(BIN) mesh pipelines/demo.json
+	$(BIN) mesh pipelines/column.json
 	GMSH=$(GMSH) cargo test --release --test all -- --ignored gmsh
-	@echo "== meshio cross-check of the demo output"
-	$(BIN) run pipelines/demo.json --out target/test-demo --quiet
+	@echo "== meshio cross-check of the column scene"
+	$(BIN) run pipelines/column.json --out target/test-column --quiet
+	$(PY) scripts/check_vtu.py target/test-column
+	@echo "== the demo's wedge scene (first 2 s) and its charts, cross-checked with meshio"
+	$(BIN) run pipelines/wedge.json --out target/test-demo --duration 2 --quiet
+	$(BIN) study chart $(STUDY) --scene pipelines/wedge.json --run target/test-demo
 	$(PY) scripts/check_vtu.py target/test-demo
 	@echo "== meshio cross-check of a scene with a joint (joint series, joint history)"
 	$(BIN) run pipelines/impact.json --out target/test-impact --quiet
@@ -65,6 +76,17 @@ mesh: venv build
 
 run: venv build
 	$(BIN) run $(SCENE)
+
+# The wedge study: plan (scenes, meshes, runs.mk), the runs and the strength reduction in
+# parallel ($(JOBS) at a time), then the report (out/wedge/report.md and charts/).
+wedge: venv build
+	$(BIN) study plan $(STUDY) --bin $(CURDIR)/$(BIN)
+	$(MAKE) --no-print-directory -j$(JOBS) -f out/wedge/runs.mk all
+	$(BIN) study report $(STUDY)
+
+# Only the report, from the runs already in out/wedge.
+wedge-report: build
+	$(BIN) study report $(STUDY)
 
 bench: build
 	cargo bench --bench explicit

@@ -194,4 +194,8 @@ MeshSize{ qf } = hw;
 Mesh.MeshSizeExtendFromBoundary = 1;
 Mesh.MeshSizeFromCurvature = 0;
 Mesh.ElementOrder = 1;
+// HXT (algorithm 10): on this geometry it gives no slivers (smallest tet altitude 0.68 m at
+// hw = 2.5 against 0.27 m with the default Delaunay), and the explicit time step is set by
+// the smallest altitude.
+Mesh.Algorithm3D = 10;
 Mesh.MshFileVersion = 4.1;

@@ -53,6 +53,7 @@ mesh socket_tet.msh           socket.geo -setnumber hp 0.2 -setnumber hs 0.3
 mesh prism_hex.msh            prism.geo -setnumber n 50 -setnumber nt 1
 mesh cantilever_hex.msh       cantilever.geo -setnumber nx 20 -setnumber ny 1 -setnumber nz 2
 mesh column_hex.msh           column.geo -setnumber nz 10 -setnumber nw 1
+mesh wedge_coarse.msh         wedge.geo -setnumber hw 8 -setnumber hr 30
 
 # malformed.msh: boxes_hex_4x3.msh cut 5 lines into its $Elements section (no $EndElements).
 awk '{ print } /^\$Elements/ { cut = NR + 5 } cut && NR >= cut { exit }' \

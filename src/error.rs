@@ -120,11 +120,17 @@ pub enum InterfaceError {
 pub enum OutputError {
     #[error("cannot write {path}: {message}")]
     Write { path: PathBuf, message: String },
+    #[error("cannot read {path}: {message}. Run the stage that writes it first (see docs/cli.md).")]
+    Read { path: PathBuf, message: String },
 }
 
 impl OutputError {
     pub fn write(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
         OutputError::Write { path: path.into(), message: e.to_string() }
+    }
+    /// A result file of an earlier stage that cannot be read.
+    pub fn read(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
+        OutputError::Read { path: path.into(), message: e.to_string() }
     }
 }
 

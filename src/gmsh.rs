@@ -63,7 +63,9 @@ pub fn mesh_geo(geo: &Path, set: &BTreeMap<String, f64>, cache_dir: &Path) -> Re
         return Ok(msh);
     }
     let cmd = gmsh_command();
-    let tmp = cache_dir.join(format!("{stem}-{key}.tmp.msh"));
+    // per-process temporary name: two runs meshing the same scene at once (`make -j`) must not
+    // write into one file; the rename below is atomic and both produce the same mesh
+    let tmp = cache_dir.join(format!("{stem}-{key}.{}.tmp.msh", std::process::id()));
     let mut c = Command::new(&cmd[0]);
     c.args(&cmd[1..]).arg(geo).arg("-3").arg("-format").arg("msh41").arg("-o").arg(&tmp);
     for (k, v) in set {

@@ -52,6 +52,9 @@ enum Cmd {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Override the scene's `time.duration` [s] (e.g. a short check of a long scene).
+        #[arg(long)]
+        duration: Option<f64>,
     },
     /// Tag the joints of a scene (slave/master, normals, Layer1/Layer2, NTN pairs) and write
     /// <out>/tagging/joints.json, one <joint>.vtu per joint and summary.json.
@@ -89,6 +92,48 @@ enum Cmd {
         /// Print the full result (input, geometry, forces, FS) as JSON.
         #[arg(long)]
         json: bool,
+    },
+    /// The wedge study of the seed paper: `plan`, `ssr`, `report`, `chart` (docs/wedge.md).
+    Study {
+        #[command(subcommand)]
+        action: StudyCmd,
+    },
+}
+
+/// Stages of the wedge study (`pipelines/wedge_study.json`; docs/wedge.md).
+#[derive(Subcommand)]
+enum StudyCmd {
+    /// Write the variant scenes, `plan.json` and the Makefile `runs.mk` of the study under its
+    /// output directory, and mesh every distinct geometry once.
+    Plan {
+        study: PathBuf,
+        #[arg(long, default_value = "build/mesh")]
+        cache: PathBuf,
+        /// The jointquake binary the generated Makefile calls.
+        #[arg(long, default_value = "target/release/jointquake")]
+        bin: String,
+    },
+    /// FEM strength reduction of the study's wedge (gravity only) → `<out>/ssr.json`.
+    Ssr {
+        study: PathBuf,
+        #[arg(long, default_value = "build/mesh")]
+        cache: PathBuf,
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Read every run, add limit equilibrium and the rigid block, write `<out>/report.md`,
+    /// `report.json` and `charts/`.
+    Report { study: PathBuf },
+    /// Charts of one run of the study's wedge (slip at P2, P1 displacement, rigid block) in
+    /// `<run>/charts/`.
+    Chart {
+        study: PathBuf,
+        /// The scene that was run.
+        #[arg(long)]
+        scene: PathBuf,
+        /// Its output directory.
+        #[arg(long)]
+        run: PathBuf,
     },
 }
 
@@ -146,16 +191,16 @@ fn real_main() -> Result<()> {
                 println!("  group \"{}\" (dim {}): {} cells", g.name, g.dim, g.cells.len());
             }
         }
-        Cmd::Run { scene, out, cache, threads, quiet } => {
+        Cmd::Run { scene, out, cache, threads, quiet, duration } => {
             if let Some(n) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
             }
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet };
+            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration };
             let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
             print!("{}", summary.to_text());
         }
         Cmd::Tag { scene, out, cache, json } => {
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false };
+            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: None };
             let summary = jointquake::pipeline::tag(&scene, &opts).with_context(|| format!("tagging the joints of scene {}", scene.display()))?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&summary).context("serialising the tag summary")?);
@@ -193,6 +238,63 @@ fn real_main() -> Result<()> {
                 println!("{}", serde_json::to_string_pretty(&out).context("serialising the wedge result")?);
             } else {
                 print!("{}", wedge_fs_report(&w).with_context(|| format!("limit equilibrium of the {}", what()))?);
+            }
+        }
+        Cmd::Study { action } => study_cmd(action)?,
+    }
+    Ok(())
+}
+
+fn study_cmd(action: StudyCmd) -> Result<()> {
+    use jointquake::study::{wedge, wedge_report};
+    let load = |p: &PathBuf| wedge::WedgeStudy::load(p).with_context(|| format!("loading study {}", p.display()));
+    match action {
+        StudyCmd::Plan { study, cache, bin } => {
+            let s = load(&study)?;
+            let files = wedge::write_plan(&study, &s, &cache, &bin).with_context(|| format!("planning study {}", study.display()))?;
+            println!("study {}: {} runs planned, {} meshes ready", s.name(), files.scenes.len(), files.meshes.len());
+            println!("  plan      {}", files.plan.display());
+            println!("  makefile  {}", files.makefile.display());
+        }
+        StudyCmd::Ssr { study, cache, threads } => {
+            if let Some(n) = threads {
+                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
+            }
+            let s = load(&study)?;
+            let r = wedge::run_ssr(&s, &cache).with_context(|| format!("strength reduction of study {}", study.display()))?;
+            let out = s.out_dir();
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let p = out.join("ssr.json");
+            std::fs::write(&p, serde_json::to_string_pretty(&r).context("serialising the strength reduction")?).with_context(|| format!("writing {}", p.display()))?;
+            println!(
+                "strength reduction ({} mesh, {} elements): F = {:.4} (bracket {:.4}–{:.4}); limit equilibrium {:.4} → {:+.1} %",
+                r.mesh, r.elements, r.result.factor, r.result.bracket[0], r.result.bracket[1], r.le_fs, 100.0 * (r.result.factor / r.le_fs - 1.0)
+            );
+            for t in &r.result.trials {
+                println!(
+                    "  F = {:.4}: {} (steps {}, residual {:.1e}, max slip {:.3e} m, |u| P1 {:.3e} m)",
+                    t.factor, if t.failed { "fails" } else { "stable" }, t.steps, t.residual, t.max_slip, t.monitor_displacement
+                );
+            }
+            println!("  written {} in {:.1} s", p.display(), r.wall_time);
+        }
+        StudyCmd::Report { study } => {
+            let s = load(&study)?;
+            let r = wedge_report::write_report(&s).with_context(|| format!("report of study {}", study.display()))?;
+            println!("wedge study report: {}", r.report.display());
+            for c in &r.charts {
+                println!("  chart {} (and .svg)", c.display());
+            }
+            for t in &r.trend {
+                println!("  {t}");
+            }
+        }
+        StudyCmd::Chart { study, scene, run } => {
+            let s = load(&study)?;
+            let (charts, slip) = wedge_report::write_run_charts(&s, &scene, &run).with_context(|| format!("charts of run {}", run.display()))?;
+            println!("residual slip at P2: {slip:.4} m");
+            for c in &charts {
+                println!("  chart {} (and .svg)", c.display());
             }
         }
     }

@@ -24,6 +24,8 @@ pub struct RunOptions {
     pub mesh_cache: Option<PathBuf>,
     /// Show a progress bar (only drawn when stderr is a terminal). Default false.
     pub progress: bool,
+    /// Replace the scene's `time.duration` [s]. Default: the scene's.
+    pub duration: Option<f64>,
 }
 
 /// Peak of a quantity and where it happened.
@@ -124,7 +126,13 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         *t = Instant::now();
     };
     let mut t = Instant::now();
-    let scene = Scene::load(scene_path)?;
+    let mut scene = Scene::load(scene_path)?;
+    if let Some(d) = opts.duration {
+        if !(d.is_finite() && d >= 0.0) {
+            return Err(crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message: format!("--duration {d}: must be a finite time ≥ 0 [s]") }.into());
+        }
+        scene.time.duration = d;
+    }
     let mesh = load_mesh(&scene, opts)?;
     let mesh_path = mesh.source.clone();
     lap("mesh", &mut t);

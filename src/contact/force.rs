@@ -23,7 +23,7 @@
 
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force, penalty_force, JointLaw, PairHistory, PairState};
-use super::query::{select_projection, INSIDE_TOL_DEFAULT};
+use super::query::{select_projection, Location, INSIDE_TOL_DEFAULT};
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
 use crate::model::Model;
@@ -122,8 +122,6 @@ struct Active {
     nm: u8,
     weights: [f64; 4],
     dt2w: f64,
-    /// Update counter when the pair was last evaluated (0: not yet this step).
-    seen: u64,
     /// Applied force components (r_n compressive, r_t) of the current Gauss–Seidel iterate.
     r_n: f64,
     r_t: Vector2<f64>,
@@ -151,10 +149,16 @@ pub struct ContactSolver<'m> {
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
     inv_mass: Vec<f64>,
     cand: Vec<u32>,
-    /// Per node: value of `counter` at its last Gauss–Seidel update. A pair none of whose nodes
-    /// changed since its last evaluation would give the same force again and is skipped (exact).
-    node_stamp: Vec<u64>,
-    counter: u64,
+    /// Gauss–Seidel work list: bit k set = active pair k must be evaluated (first sweep: all;
+    /// then only the pairs one of whose moving nodes another pair's update moved since their own
+    /// last evaluation: a pair whose nodes did not change would give the same force, so skipping
+    /// it is exact). Pairs of higher index are taken in the same sweep, lower ones in the next.
+    dirty: Vec<u64>,
+    /// Per moving node: head of its list of (pair) entries in `adj`, `u32::MAX` = none.
+    adj_head: Vec<u32>,
+    /// Entries (active pair index, next entry of the same node).
+    adj: Vec<(u32, u32)>,
+    adj_nodes: Vec<u32>,
     /// Per node: displacement change [m] applied during the current sweep, and the nodes touched.
     sweep_du: Vec<Vector3<f64>>,
     touched: Vec<u32>,
@@ -166,7 +170,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, keep_bonds: false, active: Vec::new(), penalty: Vec::new(), node_stamp: vec![0; model.n_nodes()], counter: 0, sweep_du: vec![Vector3::zeros(); model.n_nodes()], touched: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, keep_bonds: false, active: Vec::new(), penalty: Vec::new(), dirty: Vec::new(), adj_head: vec![u32::MAX; model.n_nodes()], adj: Vec::new(), adj_nodes: Vec::new(), sweep_du: vec![Vector3::zeros(); model.n_nodes()], touched: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -280,6 +284,37 @@ fn project_on(
     }
 }
 
+/// The first set bit of `bits` at or after `from`.
+fn next_dirty(bits: &[u64], from: usize) -> Option<usize> {
+    let mut w = from / 64;
+    if w >= bits.len() {
+        return None;
+    }
+    let mut word = bits[w] & (u64::MAX << (from % 64));
+    loop {
+        if word != 0 {
+            return Some(w * 64 + word.trailing_zeros() as usize);
+        }
+        w += 1;
+        if w >= bits.len() {
+            return None;
+        }
+        word = bits[w];
+    }
+}
+
+/// Mark every active pair on `node` but `except` for evaluation.
+fn mark_dirty(bits: &mut [u64], head: &[u32], adj: &[(u32, u32)], node: usize, except: usize) {
+    let mut e = head[node];
+    while e != u32::MAX {
+        let (k, next) = adj[e as usize];
+        if k as usize != except {
+            bits[k as usize / 64] |= 1u64 << (k % 64);
+        }
+        e = next;
+    }
+}
+
 impl Correction for ContactSolver<'_> {
     fn correct(
         &mut self,
@@ -312,13 +347,30 @@ impl Correction for ContactSolver<'_> {
                         ([o, 0, 0, 0], 1u8, [1.0, 0.0, 0.0, 0.0], -1i32)
                     }
                     _ => {
-                        self.candidates_into(j, pr.center, j.layer);
-                        let mut found = {
+                        // Temporal coherence: a node still strictly inside the face it was on at
+                        // the last step, and near it along its normal (within half the face
+                        // size, so that no other sheet of a folded master can be nearer), keeps
+                        // that face: the full search would choose it too (selection rules of
+                        // `select_projection`: nearest sheet, inside before edge, face id).
+                        let mut found = None;
+                        if pr.face >= 0 {
+                            let f = pr.face as usize;
+                            if let Some((ff, p)) = project_on(model, j, &[f as u32], &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT)
+                                && p.location == Location::Inside
+                            {
+                                let x0 = pos(model, conf, j.tag.master.faces[f].nodes()[0] as usize);
+                                let x1 = pos(model, conf, j.tag.master.faces[f].nodes()[1] as usize);
+                                if p.t.abs() <= 0.5 * (x1 - x0).norm() {
+                                    found = Some((ff, p));
+                                }
+                            }
+                        }
+                        if found.is_none() {
+                            self.candidates_into(j, pr.center, j.layer);
                             let cand = std::mem::take(&mut self.cand);
-                            let r = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
+                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                             self.cand = cand;
-                            r
-                        };
+                        }
                         if found.is_none() {
                             // a node just off the master's free edge (see `edge_tolerance`)
                             let cand = std::mem::take(&mut self.cand);
@@ -451,7 +503,6 @@ impl Correction for ContactSolver<'_> {
                     nm,
                     weights,
                     dt2w: dt2 * w,
-                    seen: 0,
                     r_n: 0.0,
                     r_t: Vector2::zeros(),
                     hist: pr.hist,
@@ -488,21 +539,41 @@ impl Correction for ContactSolver<'_> {
         }
 
         // ---------------------------------------------------------------- Gauss–Seidel
+        // moving node → active pairs (a linked list per node in `adj`)
+        for (k, a) in self.active.iter().enumerate() {
+            let nodes = std::iter::once(a.slave).chain(a.masters[..a.nm as usize].iter().copied());
+            for nd in nodes {
+                if self.inv_mass[nd as usize] > 0.0 {
+                    let head = &mut self.adj_head[nd as usize];
+                    if *head == u32::MAX {
+                        self.adj_nodes.push(nd);
+                    }
+                    self.adj.push((k as u32, *head));
+                    *head = (self.adj.len() - 1) as u32;
+                }
+            }
+        }
+        let words = self.active.len().div_ceil(64);
+        self.dirty.clear();
+        self.dirty.resize(words, u64::MAX);
+        if let Some(last) = self.dirty.last_mut()
+            && self.active.len() % 64 != 0
+        {
+            *last = (1u64 << (self.active.len() % 64)) - 1;
+        }
+        // A node moved by less than 1 % of the tolerance does not call its pairs back: their
+        // forces would change by a fraction of that (the fixed point is the same to within the
+        // tolerance), and on a coarse, heavy master whose nodes carry dozens of pairs those
+        // round-off-sized updates otherwise ripple through every sweep.
+        let mark_tol = 1e-2 * self.gs_tolerance;
         let mut sweeps = 0;
         let mut converged = self.active.is_empty();
         while !converged && sweeps < self.gs_max_sweeps {
             sweeps += 1;
-            for k in 0..self.active.len() {
+            let mut next = next_dirty(&self.dirty, 0);
+            while let Some(k) = next {
+                self.dirty[k / 64] &= !(1u64 << (k % 64));
                 let a = self.active[k];
-                if a.seen > 0 {
-                    let mut changed = self.node_stamp[a.slave as usize] >= a.seen;
-                    for b in 0..a.nm as usize {
-                        changed |= self.node_stamp[a.masters[b] as usize] >= a.seen;
-                    }
-                    if !changed {
-                        continue;
-                    }
-                }
                 let j = &self.joints[a.joint as usize];
                 let i = a.pair as usize;
                 let [n, t1, t2] = j.frames[i];
@@ -524,14 +595,16 @@ impl Correction for ContactSolver<'_> {
                 let resp = pair_force(&self.law_in_force(j), &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i]);
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
-                self.counter += 1;
                 if d_rn != 0.0 || d_rt.x != 0.0 || d_rt.y != 0.0 {
-                    // only nodes that move are stamped: a fixed node never changes a neighbour's force
+                    // the pairs on the nodes this update moves must be evaluated again (a fixed
+                    // node never changes a neighbour's force)
                     let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
                     let im = self.inv_mass[s];
                     if im > 0.0 {
-                        self.node_stamp[s] = self.counter;
                         let du = dr * (dt2 * im);
+                        if du.norm() > mark_tol {
+                            mark_dirty(&mut self.dirty, &self.adj_head, &self.adj, s, k);
+                        }
                         for c in 0..3 {
                             u_next[3 * s + c] += du[c];
                         }
@@ -544,8 +617,10 @@ impl Correction for ContactSolver<'_> {
                         let mi = a.masters[b] as usize;
                         let imi = self.inv_mass[mi];
                         if imi > 0.0 {
-                            self.node_stamp[mi] = self.counter;
                             let du = dr * (-dt2 * a.weights[b] * imi);
+                            if du.norm() > mark_tol {
+                                mark_dirty(&mut self.dirty, &self.adj_head, &self.adj, mi, k);
+                            }
                             for c in 0..3 {
                                 u_next[3 * mi + c] += du[c];
                             }
@@ -557,13 +632,12 @@ impl Correction for ContactSolver<'_> {
                     }
                 }
                 let e = &mut self.active[k];
-                // evaluated after its own update: later changes of its nodes carry larger stamps
-                e.seen = self.counter + 1;
                 e.r_n = resp.r_n;
                 e.r_t = resp.r_t;
                 e.hist = resp.hist;
                 e.state = resp.state;
                 e.gap = g_trial + a.dt2w * resp.r_n;
+                next = next_dirty(&self.dirty, k + 1);
             }
             let mut max_du: f64 = 0.0;
             for &nd in &self.touched {
@@ -571,8 +645,14 @@ impl Correction for ContactSolver<'_> {
                 self.sweep_du[nd as usize] = Vector3::zeros();
             }
             self.touched.clear();
-            converged = max_du <= self.gs_tolerance;
+            converged = max_du <= self.gs_tolerance || self.dirty.iter().all(|&w| w == 0);
         }
+
+        for &nd in &self.adj_nodes {
+            self.adj_head[nd as usize] = u32::MAX;
+        }
+        self.adj_nodes.clear();
+        self.adj.clear();
 
         // ---------------------------------------------------------------- record
         let mut work = penalty_work;

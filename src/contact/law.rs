@@ -56,7 +56,8 @@ pub struct JointLaw {
     /// Default false. Used for non-conforming glued blocks (dam on foundation).
     #[serde(default)]
     pub tied: bool,
-    /// Gap (m) a pair must exceed to count as *opened* for the loss of its bond. Default 0 in
+    /// Gap (m) a pair must exceed to count as *opened*, and slip increment (m) it must exceed to
+    /// count as *slipped*, for the loss of its bond. Default 0 in
     /// the pure law; `ContactJoint::build` sets it to the round-off of the joint's positions
     /// ([`OPEN_TOLERANCE_RELATIVE`] × its coordinate scale), so that a pair touching to
     /// round-off keeps its bond: at the first step of a suddenly loaded joint both sides move
@@ -217,14 +218,16 @@ pub fn pair_force(
         let state = if bonded { PairState::Bonded } else { PairState::Stick };
         return PairResponse { r_n, r_t: r_trial, state, hist: *hist, slip_increment: Vector2::zeros() };
     }
-    // Slip: back to the limit along the trial direction.
-    let intact = hist.intact && law.keep_cohesion;
+    // Slip: back to the limit along the trial direction. As for an opening, a slip within
+    // round-off (`open_tolerance`) does not break the bond.
+    let r_t = r_trial * (limit / r_trial_norm);
+    let slip_increment = dt_trial + r_t * k;
+    let slipped = slip_increment.norm() > law.open_tolerance;
+    let intact = hist.intact && (law.keep_cohesion || !slipped);
     if hist.intact && !intact && r_n < 0.0 {
         // The slip broke the bond of a pair in tension: with its new history it is open.
         return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
     }
-    let r_t = r_trial * (limit / r_trial_norm);
-    let slip_increment = dt_trial + r_t * k;
     PairResponse {
         r_n,
         r_t,

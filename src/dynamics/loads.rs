@@ -20,6 +20,54 @@ pub struct BaseMotion {
     pub scale: f64,
 }
 
+/// The base motions of a scene: each record read, converted to m/s² and scaled as the scene says
+/// (`scale`, or `pga` [g] on the record's own peak), with a note per record. Used by the FEM
+/// loads and by the rigid-block level alike, so both see the same ground motion.
+pub fn base_motions(scene: &Scene) -> Result<(Vec<BaseMotion>, Vec<String>), Error> {
+    let mut base = Vec::new();
+    let mut notes = Vec::new();
+    for b in &scene.loads.base {
+        let record = Record::read(&b.record, scene.g)?;
+        let d = Vector3::from(b.direction).normalize();
+        let scale = match (b.scale, b.pga) {
+            (_, Some(pga)) => {
+                let peak = record.peak();
+                if peak == 0.0 {
+                    return Err(ModelError::Invalid(format!("record {} is all zeros: cannot scale it to pga {pga} g", b.record.display())).into());
+                }
+                pga * scene.g / peak
+            }
+            (Some(s), None) => s,
+            (None, None) => 1.0,
+        };
+        notes.push(format!(
+            "record {}: {} samples, dt {} s, PGA {:.4} g × {:.4} along ({:.3}, {:.3}, {:.3})",
+            b.record.display(),
+            record.accel.len(),
+            record.dt,
+            record.peak() / scene.g,
+            scale,
+            d[0],
+            d[1],
+            d[2]
+        ));
+        base.push(BaseMotion { record, dir: [d[0] * scale, d[1] * scale, d[2] * scale], scale });
+    }
+    Ok((base, notes))
+}
+
+/// Ground acceleration a_g(t) [m/s²] of a set of base motions.
+pub fn ground_acceleration_of(base: &[BaseMotion], t: f64) -> [f64; 3] {
+    let mut a = [0.0; 3];
+    for b in base {
+        let v = b.record.at(t);
+        for i in 0..3 {
+            a[i] += b.dir[i] * v;
+        }
+    }
+    a
+}
+
 /// A fixed nodal force pattern with a linear ramp [s] (0 = step).
 #[derive(Clone, Debug)]
 pub struct ForcePattern {
@@ -57,34 +105,8 @@ impl Loads {
             }
             gravity_nodes = Some(mask);
         }
-        let mut base = Vec::new();
-        for b in &scene.loads.base {
-            let record = Record::read(&b.record, scene.g)?;
-            let d = Vector3::from(b.direction).normalize();
-            let scale = match (b.scale, b.pga) {
-                (_, Some(pga)) => {
-                    let peak = record.peak();
-                    if peak == 0.0 {
-                        return Err(ModelError::Invalid(format!("record {} is all zeros: cannot scale it to pga {pga} g", b.record.display())).into());
-                    }
-                    pga * scene.g / peak
-                }
-                (Some(s), None) => s,
-                (None, None) => 1.0,
-            };
-            notes.push(format!(
-                "record {}: {} samples, dt {} s, PGA {:.4} g × {:.4} along ({:.3}, {:.3}, {:.3})",
-                b.record.display(),
-                record.accel.len(),
-                record.dt,
-                record.peak() / scene.g,
-                scale,
-                d[0],
-                d[1],
-                d[2]
-            ));
-            base.push(BaseMotion { record, dir: [d[0] * scale, d[1] * scale, d[2] * scale], scale });
-        }
+        let (base, base_notes) = base_motions(scene)?;
+        notes.extend(base_notes);
         let mut patterns = Vec::new();
         for t in &scene.loads.traction {
             let g = model.mesh.group_of_dim(&t.group, 2)?;
@@ -109,14 +131,7 @@ impl Loads {
 
     /// Ground acceleration vector a_g(t) [m/s²].
     pub fn ground_acceleration(&self, t: f64) -> [f64; 3] {
-        let mut a = [0.0; 3];
-        for b in &self.base {
-            let v = b.record.at(t);
-            for i in 0..3 {
-                a[i] += b.dir[i] * v;
-            }
-        }
-        a
+        ground_acceleration_of(&self.base, t)
     }
 
     /// End of the longest record [s] (0 without records).

@@ -4,3 +4,5 @@
 
 pub mod rigid_level;
 pub mod ssr;
+pub mod wedge;
+pub mod wedge_report;

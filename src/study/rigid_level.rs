@@ -1,12 +1,12 @@
 //! The rigid-block level of a study: the scene's own wedge and base records, slid as one rigid
 //! body along its line of intersection (Newmark, [`crate::rigid::newmark`]).
 //!
-//! Shares the record code with the FEM runs: the ground acceleration is [`Loads::ground_acceleration`]
-//! of the very scene the FEM run uses (same files, scales, directions, g), sampled at the
-//! records' own step. Horizontal components along x and y are combined exactly for one-way
+//! Shares the record code with the FEM runs: the ground acceleration is that of
+//! [`crate::dynamics::loads::base_motions`] of the very scene the FEM run uses (same files,
+//! scales, directions, g), sampled at the records' own step. Horizontal components along x and y are combined exactly for one-way
 //! sliding: the down-slope rate is linear in (kx, ky, kv), r = r0 + r_x kx + r_y ky + r_v kv.
 
-use crate::dynamics::loads::Loads;
+use crate::dynamics::loads::{ground_acceleration_of, BaseMotion};
 use crate::error::{Error, ModelError};
 use crate::rigid::newmark::{slide, slide_with_bond_loss, Direction, NewmarkOptions, NewmarkResult};
 use crate::rigid::wedge::{wedge_seismic_coeffs, WedgeInput};
@@ -35,10 +35,10 @@ pub struct RigidWedgeRun {
     pub result: NewmarkResult,
 }
 
-/// Ground acceleration of `loads` sampled every `dt` over [0, t_end] [m/s², x y z].
-pub fn sample_ground_motion(loads: &Loads, dt: f64, t_end: f64) -> Vec<[f64; 3]> {
+/// Ground acceleration of `base` sampled every `dt` over [0, t_end] [m/s², x y z].
+pub fn sample_ground_motion(base: &[BaseMotion], dt: f64, t_end: f64) -> Vec<[f64; 3]> {
     let n = (t_end / dt).round() as usize + 1;
-    (0..n).map(|i| loads.ground_acceleration(i as f64 * dt)).collect()
+    (0..n).map(|i| ground_acceleration_of(base, i as f64 * dt)).collect()
 }
 
 /// Slide the rigid wedge `input` under the ground motion `a` (samples every `dt`, m/s²).
@@ -80,29 +80,3 @@ pub fn rigid_wedge_slip(input: &WedgeInput, a: &[[f64; 3]], dt: f64, bond: Bond,
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn scratch_coeffs() {
-        for keep in [true, false] {
-            let c = crate::rigid::wedge::wedge_seismic_coeffs(&WedgeInput::default(), 0.0, keep).unwrap();
-            eprintln!("{c:?}");
-        }
-    }
-
-    #[test]
-    fn scratch_elcentro() {
-        let rec = crate::dynamics::record::Record::read(std::path::Path::new("pipelines/records/elcentro1940_NS_chopra.txt"), 9.81).unwrap();
-        let peak = rec.peak();
-        for pga in [0.2, 0.5, 0.8, 1.0, 1.5] {
-            let f = pga * 9.81 / peak;
-            let a: Vec<[f64; 3]> = rec.accel.iter().map(|x| [0.0, f * x, f * x * 2.0 / 3.0]).collect();
-            for bond in [Bond::Kept, Bond::Brittle] {
-                let r = rigid_wedge_slip(&WedgeInput::default(), &a, rec.dt, bond, false).unwrap();
-                eprintln!("pga {pga} {bond:?} kc {:?} {:?} slip {:.4} episodes {} liftoff {}", r.kc_intact, r.kc_residual, r.result.residual_displacement, r.result.n_episodes, r.result.lift_off_samples);
-            }
-        }
-    }
-}

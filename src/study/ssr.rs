@@ -14,7 +14,7 @@ use crate::error::{Error, ModelError};
 use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::scene::Scene;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Settings of a strength-reduction search.
 #[derive(Clone, Debug, Serialize)]
@@ -40,7 +40,7 @@ impl Default for SsrOptions {
 }
 
 /// One trial of the search.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SsrTrial {
     pub factor: f64,
     pub failed: bool,
@@ -54,7 +54,7 @@ pub struct SsrTrial {
 }
 
 /// Result: the bracket and every trial (in the order run).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct SsrResult {
     pub factor: f64,
     pub bracket: [f64; 2],

@@ -13,3 +13,4 @@ mod outputs;
 mod report;
 mod rigid;
 mod tagging;
+mod wedge;
