@@ -10,7 +10,10 @@ GMSH_RUN  := $(CURDIR)/$(VENV)/bin/gmsh-run
 GMSH      ?= $(GMSH_RUN)
 export GMSH
 BIN       := target/release/jointquake
-SCENE     ?= pipelines/column.json
+SCENE     ?= pipelines/wedge.json
+STUDY     ?= pipelines/wedge_study.json
+# Parallel runs of `make wedge` (independent scenes, one thread each). Default: all cores.
+JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
