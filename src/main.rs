@@ -9,6 +9,27 @@ use jointquake::pipeline::RunOptions;
 use jointquake::rigid::wedge::{analyse_wedge, critical_horizontal_acceleration, strength_reduction_factor, wedge_fs_report, HeightDef, WedgeInput, WedgeResult};
 use std::path::PathBuf;
 
+/// `println!` that ends the process quietly when stdout is closed (`jointquake … | head`): the
+/// standard macro panics on a broken pipe.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if writeln!(std::io::stdout(), $($t)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
+/// `print!` with the same behaviour as [`say!`].
+macro_rules! say_raw {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if write!(std::io::stdout(), $($t)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "jointquake",
@@ -185,10 +206,10 @@ fn real_main() -> Result<()> {
             let s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
             let opts = RunOptions { mesh_cache: Some(cache), ..Default::default() };
             let mesh = jointquake::pipeline::load_mesh(&s, &opts).with_context(|| format!("meshing scene {}", scene.display()))?;
-            println!("{}", mesh.source.display());
-            println!("  {} nodes, {} cells", mesh.nodes.len(), mesh.cells.len());
+            say!("{}", mesh.source.display());
+            say!("  {} nodes, {} cells", mesh.nodes.len(), mesh.cells.len());
             for g in &mesh.groups {
-                println!("  group \"{}\" (dim {}): {} cells", g.name, g.dim, g.cells.len());
+                say!("  group \"{}\" (dim {}): {} cells", g.name, g.dim, g.cells.len());
             }
         }
         Cmd::Run { scene, out, cache, threads, quiet, duration } => {
@@ -197,15 +218,15 @@ fn real_main() -> Result<()> {
             }
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration };
             let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
-            print!("{}", summary.to_text());
+            say_raw!("{}", summary.to_text());
         }
         Cmd::Tag { scene, out, cache, json } => {
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: None };
             let summary = jointquake::pipeline::tag(&scene, &opts).with_context(|| format!("tagging the joints of scene {}", scene.display()))?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&summary).context("serialising the tag summary")?);
+                say!("{}", serde_json::to_string_pretty(&summary).context("serialising the tag summary")?);
             } else {
-                print!("{}", summary.to_text());
+                say_raw!("{}", summary.to_text());
             }
         }
         Cmd::WedgeFs { input, height_def, h, json } => {
@@ -235,9 +256,9 @@ fn real_main() -> Result<()> {
                 let srf = strength_reduction_factor(&w).with_context(|| format!("strength reduction of the {}", what()))?;
                 let kc = critical_horizontal_acceleration(&w, 0.0).with_context(|| format!("critical acceleration of the {}", what()))?;
                 let out = WedgeFsJson { result, strength_reduction_factor: srf, critical_kh_azimuth_0: kc };
-                println!("{}", serde_json::to_string_pretty(&out).context("serialising the wedge result")?);
+                say!("{}", serde_json::to_string_pretty(&out).context("serialising the wedge result")?);
             } else {
-                print!("{}", wedge_fs_report(&w).with_context(|| format!("limit equilibrium of the {}", what()))?);
+                say_raw!("{}", wedge_fs_report(&w).with_context(|| format!("limit equilibrium of the {}", what()))?);
             }
         }
         Cmd::Study { action } => study_cmd(action)?,
@@ -252,9 +273,9 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
         StudyCmd::Plan { study, cache, bin } => {
             let s = load(&study)?;
             let files = wedge::write_plan(&study, &s, &cache, &bin).with_context(|| format!("planning study {}", study.display()))?;
-            println!("study {}: {} runs planned, {} meshes ready", s.name(), files.scenes.len(), files.meshes.len());
-            println!("  plan      {}", files.plan.display());
-            println!("  makefile  {}", files.makefile.display());
+            say!("study {}: {} runs planned, {} meshes ready", s.name(), files.scenes.len(), files.meshes.len());
+            say!("  plan      {}", files.plan.display());
+            say!("  makefile  {}", files.makefile.display());
         }
         StudyCmd::Ssr { study, cache, threads } => {
             if let Some(n) = threads {
@@ -266,35 +287,35 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
             std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
             let p = out.join("ssr.json");
             std::fs::write(&p, serde_json::to_string_pretty(&r).context("serialising the strength reduction")?).with_context(|| format!("writing {}", p.display()))?;
-            println!(
+            say!(
                 "strength reduction ({} mesh, {} elements): F = {:.4} (bracket {:.4}–{:.4}); limit equilibrium {:.4} → {:+.1} %",
                 r.mesh, r.elements, r.result.factor, r.result.bracket[0], r.result.bracket[1], r.le_fs, 100.0 * (r.result.factor / r.le_fs - 1.0)
             );
             for t in &r.result.trials {
-                println!(
+                say!(
                     "  F = {:.4}: {} (steps {}, residual {:.1e}, max slip {:.3e} m, |u| P1 {:.3e} m)",
                     t.factor, if t.failed { "fails" } else { "stable" }, t.steps, t.residual, t.max_slip, t.monitor_displacement
                 );
             }
-            println!("  written {} in {:.1} s", p.display(), r.wall_time);
+            say!("  written {} in {:.1} s", p.display(), r.wall_time);
         }
         StudyCmd::Report { study } => {
             let s = load(&study)?;
             let r = wedge_report::write_report(&s).with_context(|| format!("report of study {}", study.display()))?;
-            println!("wedge study report: {}", r.report.display());
+            say!("wedge study report: {}", r.report.display());
             for c in &r.charts {
-                println!("  chart {} (and .svg)", c.display());
+                say!("  chart {} (and .svg)", c.display());
             }
             for t in &r.trend {
-                println!("  {t}");
+                say!("  {t}");
             }
         }
         StudyCmd::Chart { study, scene, run } => {
             let s = load(&study)?;
             let (charts, slip) = wedge_report::write_run_charts(&s, &scene, &run).with_context(|| format!("charts of run {}", run.display()))?;
-            println!("residual slip at P2: {slip:.4} m");
+            say!("residual slip at P2: {slip:.4} m");
             for c in &charts {
-                println!("  chart {} (and .svg)", c.display());
+                say!("  chart {} (and .svg)", c.display());
             }
         }
     }

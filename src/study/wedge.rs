@@ -415,8 +415,10 @@ pub fn variant_scene(base: &Scene, study: &WedgeStudy, run: &RunSpec) -> Result<
         j.layer = Some(run.layer);
     }
     if run.rigid_rock {
-        // every node of every non-wedge volume is fixed: the groups that carry no gravity
-        let wedge_groups = s.loads.gravity.as_ref().and_then(|g| g.groups.clone()).unwrap_or_default();
+        // every node of every volume that carries no weight (the rock) is fixed
+        let wedge_groups = s.loads.gravity.as_ref().and_then(|g| g.groups.clone()).ok_or_else(|| {
+            ModelError::Invalid("study `rigid_rock`: the base scene's gravity must name the sliding blocks in `loads.gravity.groups` (the other volumes are the rock that is fixed)".into())
+        })?;
         for m in &base.materials {
             if !wedge_groups.contains(&m.group) {
                 s.boundary.push(crate::scene::BoundarySpec { group: m.group.clone(), fix: vec!["x".into(), "y".into(), "z".into()] });

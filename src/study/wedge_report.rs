@@ -128,11 +128,12 @@ fn slip_series(w: &PointHistory, r: &PointHistory, e: [f64; 3]) -> Vec<(f64, f64
     (0..n).map(|i| (w.t[i], s(i) - s0)).collect()
 }
 
+/// Every `stride`-th sample so that at most about `max` remain, always with the last one.
 fn thin<T: Copy>(v: &[T], max: usize) -> Vec<T> {
-    let stride = v.len().div_ceil(max).max(1);
+    let stride = v.len().div_ceil(max.max(1)).max(1);
     let mut out: Vec<T> = v.iter().step_by(stride).copied().collect();
     if let Some(last) = v.last()
-        && v.len() % stride != 1 % stride.max(1)
+        && (v.len() - 1) % stride != 0
     {
         out.push(*last);
     }

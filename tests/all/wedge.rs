@@ -118,8 +118,10 @@ fn wedge_seismic_run_slides_only_above_the_critical_acceleration() {
     // acceleration towards north is kc = −r0/rh = 0.0445 g (rigid::wedge, equal to
     // refs/analytic.py's wedge coefficients). A rectangular pulse of 0.8 kc for 0.3 s must
     // leave no slip (< 1 mm: elastic relative displacement only); 3 kc must slide, by the
-    // rigid-block closed form d = a1 t0²/2 + (a1 t0)²/(2|r0|), a1 = r0 + rh·3kc, within 10 %
-    // (the elastic wedge on a non-conforming coarse joint; measured below).
+    // rigid-block closed form d = a1 t0²/2 + (a1 t0)²/(2|r0|), a1 = r0 + rh·3kc, within 12 %.
+    // The wedge is stiff (E = 1e11 Pa) to approach the rigid block. Measured: +9.3 % on this
+    // coarse mesh (34 slave nodes per joint), −0.13 % on the medium mesh of pipelines/wedge.json
+    // (hw 4): the difference is the coarse discretisation and it converges away.
     let dir = scratch("wedge/kc");
     let c = wedge_seismic_coeffs(&WedgeInput::default(), 0.0, false).unwrap();
     let kc = c.critical_horizontal_acceleration().unwrap();
@@ -132,6 +134,10 @@ fn wedge_seismic_run_slides_only_above_the_critical_acceleration() {
         let v = wedge_scene(json!({
             "name": format!("kc{factor}"),
             "boundary": [{"group": "bc:fixed"}, {"group": "block:rock"}],
+            "materials": [
+                {"group": "block:wedge", "E": 1e11, "nu": 0.25, "rho": 2563},
+                {"group": "block:rock", "E": 1e10, "nu": 0.25, "rho": 2563}
+            ],
             "joints": [
                 {"name": "A", "master": "joint:A:rock", "slave": "joint:A:wedge", "phi": 20},
                 {"name": "B", "master": "joint:B:rock", "slave": "joint:B:wedge", "phi": 30}
@@ -155,7 +161,7 @@ fn wedge_seismic_run_slides_only_above_the_critical_acceleration() {
     let exact = a1 * t0 * t0 / 2.0 + (a1 * t0).powi(2) / (2.0 * -c.r0());
     eprintln!("slip at 0.8 kc: {:.3e} m; at 3 kc: {:.4} m, rigid closed form {exact:.4} m ({:+.1} %)", slips[0], slips[1], 100.0 * (slips[1] / exact - 1.0));
     assert!(slips[0].abs() < 1e-3, "below kc the wedge slid {} m", slips[0]);
-    assert!(slips[1] > 0.0 && rel(slips[1], exact) < 0.10, "above kc: {} m vs {exact} m", slips[1]);
+    assert!(slips[1] > 0.0 && rel(slips[1], exact) < 0.12, "above kc: {} m vs {exact} m", slips[1]);
 }
 
 #[test]
