@@ -6,7 +6,9 @@
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use jointquake::pipeline::RunOptions;
-use jointquake::rigid::wedge::{analyse_wedge, critical_horizontal_acceleration, strength_reduction_factor, wedge_fs_report, HeightDef, WedgeInput, WedgeResult};
+use jointquake::rigid::wedge::{
+    analyse_wedge, critical_horizontal_acceleration, strength_reduction_factor, wedge_fs_report, HeightDef, PlaneOrientation, TensionCrack, WedgeInput, WedgeResult,
+};
 use std::path::PathBuf;
 
 /// `println!` that ends the process quietly when stdout is closed (`jointquake … | head`): the
@@ -110,6 +112,14 @@ enum Cmd {
         /// Wedge height H [m] (default 39.624, the seed wedge).
         #[arg(long = "H", visible_alias = "height", value_name = "METRES", allow_negative_numbers = true)]
         h: Option<f64>,
+        /// Tension crack orientation, dip/dip direction [deg] (e.g. 70/165); needs
+        /// --crack-distance unless the input file has a crack. Overrides the file.
+        #[arg(long, value_name = "DIP/DIPDIR", value_parser = parse_orientation)]
+        crack: Option<PlaneOrientation>,
+        /// Tension crack position L [m]: distance behind the crest point QA along the trace of
+        /// plane A on the upper slope, towards P. Overrides the file.
+        #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+        crack_distance: Option<f64>,
         /// Print the full result (input, geometry, forces, FS) as JSON.
         #[arg(long)]
         json: bool,
@@ -162,6 +172,14 @@ enum StudyCmd {
 enum HeightDefArg {
     Intersection,
     CrestOnA,
+}
+
+/// `DIP/DIPDIR` in degrees, e.g. `70/165` (range checks are the library's).
+fn parse_orientation(s: &str) -> std::result::Result<PlaneOrientation, String> {
+    let bad = || format!("expected DIP/DIPDIR in degrees, e.g. 70/165, got {s:?}");
+    let (d, a) = s.split_once('/').ok_or_else(bad)?;
+    let num = |x: &str| x.trim().parse::<f64>().map_err(|_| bad());
+    Ok(PlaneOrientation::new(num(d)?, num(a)?))
 }
 
 /// `wedge-fs --json`: the limit-equilibrium result plus the two derived numbers of the table.
@@ -229,7 +247,7 @@ fn real_main() -> Result<()> {
                 say_raw!("{}", summary.to_text());
             }
         }
-        Cmd::WedgeFs { input, height_def, h, json } => {
+        Cmd::WedgeFs { input, height_def, h, crack, crack_distance, json } => {
             let mut w = match &input {
                 Some(p) => {
                     let text = std::fs::read_to_string(p).with_context(|| format!("reading wedge input {}", p.display()))?;
@@ -246,6 +264,14 @@ fn real_main() -> Result<()> {
             }
             if let Some(h) = h {
                 w.height = h;
+            }
+            match (crack, crack_distance, w.tension_crack.as_mut()) {
+                (Some(orientation), Some(distance), _) => w.tension_crack = Some(TensionCrack { orientation, distance }),
+                (Some(orientation), None, Some(tc)) => tc.orientation = orientation,
+                (None, Some(distance), Some(tc)) => tc.distance = distance,
+                (Some(_), None, None) => anyhow::bail!("--crack needs --crack-distance L [m] (distance behind the crest along the trace of plane A), or a tension_crack in the --input file"),
+                (None, Some(_), None) => anyhow::bail!("--crack-distance needs --crack DIP/DIPDIR (the crack orientation), or a tension_crack in the --input file"),
+                (None, None, _) => {}
             }
             let what = || match &input {
                 Some(p) => format!("wedge of {}", p.display()),

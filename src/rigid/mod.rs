@@ -40,6 +40,14 @@ pub enum RigidError {
     NotAWedge { reason: String },
     #[error("the wedge is not in contact with plane {plane} under {load} (normal reaction {force:.4e} N <= 0): it would slide on the other plane alone or lift off, which the two-plane limit equilibrium does not cover. Check the plane orientations.")]
     LostContact { plane: char, load: String, force: f64 },
+    #[error("tension crack {crack} at L = {distance} m does not cut the wedge: {reason}. Give 0 <= L < {trace_length:.3} m (L is measured from the crest point QA, L = 0, along the trace of plane A on the upper slope to P, L = {trace_length:.3} m), or leave the crack out.")]
+    CrackMissesWedge { crack: String, distance: f64, trace_length: f64, reason: String },
+    #[error("tension crack {crack} at L = {distance} m cuts off the toe: {reason}, so the crack would split the wedge instead of bounding it behind the crest. A tension crack must run from the upper slope behind the crest down into the wedge and keep the toe O in front of it: give a steeper crack dipping towards the slope face (or a vertical one), or leave the crack out.")]
+    CrackCutsOffToe { crack: String, distance: f64, reason: String },
+    #[error("tension crack {crack} at L = {distance} m leaves nothing of the wedge in front of it (truncated volume {volume:.3e} m3 of the {full_volume:.3e} m3 tetrahedron): it passes through the toe O with the rest of the wedge behind it. Give a larger L or another crack orientation.")]
+    CrackLeavesNothing { crack: String, distance: f64, volume: f64, full_volume: f64 },
+    #[error("a tension crack ({crack}) is supported for a dry wedge only (water = \"dry\"): the Hoek & Bray short-solution water pressure (water = \"hoek_bray_short\") assumes the untruncated tetrahedron, and the comprehensive solution with water in the crack is not implemented. Set water to \"dry\" or remove the tension crack.")]
+    CrackWithWater { crack: String },
     #[error("strength reduction: no limit state for a reduction factor in [{lo:.3e}, {hi:.3e}] ({reason})")]
     NoLimitState { lo: f64, hi: f64, reason: String },
     #[error("{what}: sample {index} is {value} (not finite). Check the record.")]

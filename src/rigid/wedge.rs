@@ -22,7 +22,23 @@
 //! Water ([`Water::HoekBrayShort`]): wedge saturated, pressure zero on the free faces and
 //! γw H/2 on the line of intersection (H = rise of the line), so U = γw H A / 6 per joint.
 //!
-//! Not covered: tension crack (truncated wedge), a wedge in contact with one plane only
+//! Tension crack ([`TensionCrack`], dry only): a plane of given dip / dip direction through
+//! the point X0 at distance L from the crest point QA along the trace of plane A on the
+//! upper slope, towards P (Hoek & Bray's appendix definition, 0 ≤ L < |QA P|). The wedge is
+//! the tetrahedron clipped by that plane, keeping the side of the toe O and of the crest:
+//! each face triangle is clipped by the half-space, the solid is closed by the cap polygon
+//! on the crack, the volume is a sum of tetrahedra (an inner point to a fan of each face).
+//! The same limit equilibrium then uses the truncated weight and the clipped areas on A and
+//! B (the crack face carries no force), and so do [`strength_reduction_factor`] and
+//! [`wedge_seismic_coeffs`] (both go through [`analyse_wedge`]). The crack always cuts off P;
+//! it may also cut off QB (crossing the slope face near QB), which the clipping handles.
+//! Errors: L ≥ |QA P| ([`RigidError::CrackMissesWedge`]), the toe O behind the crack
+//! ([`RigidError::CrackCutsOffToe`]), no volume left ([`RigidError::CrackLeavesNothing`]),
+//! a crack with water pressure ([`RigidError::CrackWithWater`]: the comprehensive water
+//! case with a water-filled crack is not implemented). Reference: `clipped_wedge_fs` of the
+//! same script (appendix wedge, crack 70/165, L = 12.192 m, H1 = 30.48 m: FS 1.7369).
+//!
+//! Not covered: water with a tension crack, a wedge in contact with one plane only
 //! (reported as [`RigidError::LostContact`]), external loads other than the pseudo-static
 //! ground acceleration.
 
@@ -100,10 +116,30 @@ pub enum Water {
     HoekBrayShort,
 }
 
+/// A tension crack behind the crest (Hoek & Bray's appendix definition): a plane of
+/// orientation `orientation` through the point at distance `distance` from the crest point
+/// QA along the trace of plane A on the upper slope (towards P). It truncates the wedge; the
+/// part in front of it (the side of the toe O and the crest) is analysed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TensionCrack {
+    /// Dip / dip direction of the crack plane [deg]; no default (both required).
+    pub orientation: PlaneOrientation,
+    /// L [m]: distance from the crest point QA along the trace of plane A on the upper slope
+    /// towards P, 0 <= L < |QA P|; no default (required).
+    pub distance: f64,
+}
+
+impl std::fmt::Display for TensionCrack {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} at L = {} m", self.orientation, self.distance)
+    }
+}
+
 /// Everything the limit equilibrium needs. `Default` is the seed-paper wedge
 /// (Hoek & Bray's example in SI: A 45/105, B 70/235, face 65/185, upper 12/195,
 /// H = 39.624 m along the intersection, cA 24 kPa φA 20°, cB 48 kPa φB 30°,
-/// ρ = 2563 kg/m³, g = 9.81 m/s², dry).
+/// ρ = 2563 kg/m³, g = 9.81 m/s², dry, no tension crack).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WedgeInput {
@@ -123,6 +159,9 @@ pub struct WedgeInput {
     pub water: Water,
     /// Water density [kg/m³] (default 1000), used only with water pressure.
     pub water_density: f64,
+    /// Tension crack truncating the wedge (default none: the full tetrahedron). Dry only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tension_crack: Option<TensionCrack>,
 }
 
 impl Default for WedgeInput {
@@ -140,6 +179,7 @@ impl Default for WedgeInput {
             g: 9.81,
             water: Water::Dry,
             water_density: 1000.0,
+            tension_crack: None,
         }
     }
 }
@@ -160,11 +200,20 @@ impl WedgeInput {
                 return Err(RigidError::invalid(&format!("friction angle of plane {name} [deg]"), j.friction, "must be in 0..90"));
             }
         }
+        if let Some(tc) = &self.tension_crack {
+            tc.orientation.check("tension crack")?;
+            non_negative("tension crack distance L behind the crest [m]", tc.distance)?;
+            if self.water != Water::Dry {
+                return Err(RigidError::CrackWithWater { crack: tc.to_string() });
+            }
+        }
         Ok(())
     }
 }
 
-/// The wedge tetrahedron and its measures.
+/// The wedge tetrahedron and its measures. With a tension crack, the vertices O, P, QA, QB
+/// are those of the untruncated tetrahedron and the volume and areas those of the truncated
+/// wedge (details in `crack`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WedgeGeometry {
     /// Toe O: the line of intersection daylights in the slope face here (origin) [m].
@@ -192,12 +241,45 @@ pub struct WedgeGeometry {
     pub height_intersection: f64,
     pub height_crest_a: f64,
     pub height_crest_b: f64,
-    /// Volume [m³] and face areas [m²]: A (O P QA), B (O P QB), face (O QA QB), upper (P QA QB).
+    /// Volume [m³] and face areas [m²] of the wedge that is analysed: A (O P QA), B (O P QB),
+    /// face (O QA QB), upper (P QA QB), each clipped by the tension crack if there is one.
     pub volume: f64,
     pub area_a: f64,
     pub area_b: f64,
     pub area_face: f64,
     pub area_upper: f64,
+    /// The truncation by the tension crack (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crack: Option<CrackGeometry>,
+}
+
+/// The wedge truncated by a tension crack: the tetrahedron O P QA QB clipped by the crack
+/// plane, keeping the side of the toe O (and of the crest point QA).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CrackGeometry {
+    /// The crack as given (orientation [deg], L [m]).
+    pub crack: TensionCrack,
+    /// Upward unit normal of the crack plane.
+    pub normal: [f64; 3],
+    /// X0: where the crack meets the trace of plane A on the upper slope, L from QA towards P [m].
+    pub point: [f64; 3],
+    /// |QA P|: length of the trace of plane A on the upper slope [m] (the largest L).
+    pub trace_length_a: f64,
+    /// Where the crack cuts the line of intersection O P [m] (null if it does not, i.e. if
+    /// it passes through the toe).
+    pub on_intersection: Option<[f64; 3]>,
+    /// Vertices of the tetrahedron cut off by the crack (always "P"; "QB" too if the crack
+    /// also crosses the slope face near QB).
+    pub removed: Vec<String>,
+    /// Vertices of the truncated wedge [m]: the kept tetrahedron vertices, then the points
+    /// where the crack cuts the tetrahedron's edges.
+    pub vertices: Vec<[f64; 3]>,
+    /// Area of the crack face of the truncated wedge [m²].
+    pub area_crack: f64,
+    /// The untruncated tetrahedron: volume [m³], areas on A and B [m²].
+    pub full_volume: f64,
+    pub full_area_a: f64,
+    pub full_area_b: f64,
 }
 
 /// Limit-equilibrium result. Forces in N, FS dimensionless.
@@ -279,6 +361,15 @@ pub fn build_wedge(input: &WedgeInput) -> Result<WedgeGeometry, RigidError> {
     let c = (o + p + qa + qb) / 4.0;
     let inward = |n: V3| if n.dot(&(c - o)) >= 0.0 { n } else { -n };
     let (trend, plunge) = trend_plunge(e);
+    let full = [volume, tri_area(o, p, qa), tri_area(o, p, qb), tri_area(o, qa, qb), tri_area(p, qa, qb)];
+    let (measures, crack) = match &input.tension_crack {
+        None => (full, None),
+        Some(tc) => {
+            let (t, crack) = truncate(tc, [o, p, qa, qb], full)?;
+            ([t.volume, t.area_a, t.area_b, t.area_face, t.area_upper], Some(crack))
+        }
+    };
+    let [volume, area_a, area_b, area_face, area_upper] = measures;
     Ok(WedgeGeometry {
         o: o.into(),
         p: p.into(),
@@ -297,11 +388,160 @@ pub fn build_wedge(input: &WedgeInput) -> Result<WedgeGeometry, RigidError> {
         height_crest_a: qa.z - o.z,
         height_crest_b: qb.z - o.z,
         volume,
-        area_a: tri_area(o, p, qa),
-        area_b: tri_area(o, p, qb),
-        area_face: tri_area(o, qa, qb),
-        area_upper: tri_area(p, qa, qb),
+        area_a,
+        area_b,
+        area_face,
+        area_upper,
+        crack,
     })
+}
+
+/// Measures of the truncated wedge.
+struct Truncated {
+    volume: f64,
+    area_a: f64,
+    area_b: f64,
+    area_face: f64,
+    area_upper: f64,
+}
+
+/// Clip the tetrahedron `[O, P, QA, QB]` by the tension crack, keeping the side of the toe
+/// and the crest (Hoek & Bray: the crack lies behind the crest). Each face triangle is
+/// clipped by the half-space (Sutherland-Hodgman), the solid is closed by the cap polygon
+/// on the crack plane, and the volume is the sum of the tetrahedra from an inner point to a
+/// fan of each face. `full` = [volume, area A, B, face, upper] of the tetrahedron.
+fn truncate(tc: &TensionCrack, tet: [V3; 4], full: [f64; 5]) -> Result<(Truncated, CrackGeometry), RigidError> {
+    let [o, p, qa, qb] = tet;
+    let name = tc.orientation.to_string();
+    let nt = tc.orientation.normal();
+    let trace = p - qa;
+    let trace_length = trace.norm();
+    let t3 = trace / trace_length;
+    let x0 = qa + t3 * tc.distance;
+    let misses = |reason: String| RigidError::CrackMissesWedge { crack: name.clone(), distance: tc.distance, trace_length, reason };
+    if tc.distance >= trace_length {
+        return Err(misses(format!(
+            "it meets the trace of plane A on the upper slope {:.3} m beyond P, outside the wedge",
+            tc.distance - trace_length
+        )));
+    }
+    let along = nt.dot(&t3);
+    if along.abs() < 1e-9 {
+        return Err(RigidError::invalid(
+            &format!("angle between the tension crack {name} and the trace of plane A on the upper slope [deg]"),
+            along.asin().to_degrees(),
+            "must not be 0: a crack containing that trace cannot be placed by its distance L along it; give another crack orientation",
+        ));
+    }
+    // Signed distance to the crack plane, positive on the crest side (where QA lies for L > 0:
+    // f(QA) = -L nt·t3 before the sign), snapped to 0 within the round-off of the wedge size.
+    let scale = [p, qa, qb].iter().map(|v| v.norm()).fold(0.0, f64::max);
+    let tol = 1e-9 * scale;
+    let side = -along.signum();
+    let f = |x: &V3| {
+        let d = side * nt.dot(&(x - x0));
+        if d.abs() <= tol { 0.0 } else { d }
+    };
+    let names = ["O", "P", "QA", "QB"];
+    let fs: Vec<f64> = tet.iter().map(f).collect();
+    if fs[0] < 0.0 {
+        return Err(RigidError::CrackCutsOffToe {
+            crack: name.clone(),
+            distance: tc.distance,
+            reason: format!(
+                "the toe O lies {:.3} m behind the crack plane, on the far side from the crest point QA",
+                -fs[0]
+            ),
+        });
+    }
+    if fs.iter().all(|&d| d >= 0.0) {
+        // Not reached for 0 <= L < |QA P| (P is then strictly behind), kept for round-off.
+        return Err(misses("it passes through P to within round-off and cuts nothing off".into()));
+    }
+    // Clip one convex polygon (vertices with their f) to f >= 0.
+    let clip = |poly: &[(V3, f64)]| -> Vec<(V3, f64)> {
+        let mut out = Vec::new();
+        for i in 0..poly.len() {
+            let (a, fa) = poly[i];
+            let (b, fb) = poly[(i + 1) % poly.len()];
+            if fa >= 0.0 {
+                out.push((a, fa));
+            }
+            if (fa > 0.0 && fb < 0.0) || (fa < 0.0 && fb > 0.0) {
+                out.push((a + (b - a) * (fa / (fa - fb)), 0.0));
+            }
+        }
+        out
+    };
+    let vf = |i: usize| (tet[i], fs[i]);
+    // Faces A (O P QA), B (O P QB), slope face (O QA QB), upper slope (P QA QB).
+    let faces: Vec<Vec<V3>> = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
+        .iter()
+        .map(|ix| clip(&ix.map(vf)).into_iter().map(|(x, _)| x).collect())
+        .collect();
+    // Vertices of the truncated solid: kept tetrahedron vertices, then the cut points.
+    let mut vertices: Vec<V3> = (0..4).filter(|&i| fs[i] >= 0.0).map(|i| tet[i]).collect();
+    let mut cap: Vec<V3> = (0..4).filter(|&i| fs[i] == 0.0).map(|i| tet[i]).collect();
+    for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+        let (fa, fb) = (fs[i], fs[j]);
+        if (fa > 0.0 && fb < 0.0) || (fa < 0.0 && fb > 0.0) {
+            let x = tet[i] + (tet[j] - tet[i]) * (fa / (fa - fb));
+            vertices.push(x);
+            cap.push(x);
+        }
+    }
+    // Order the cap polygon around its centroid in the crack plane.
+    let cc = cap.iter().fold(V3::zeros(), |s, x| s + x) / cap.len().max(1) as f64;
+    let u = if nt.cross(&V3::z()).norm() > 1e-6 { nt.cross(&V3::z()).normalize() } else { V3::x() };
+    let w = nt.cross(&u);
+    cap.sort_by(|a, b| {
+        let ang = |x: &V3| (x - cc).dot(&w).atan2((x - cc).dot(&u));
+        ang(a).total_cmp(&ang(b))
+    });
+    let inner = vertices.iter().fold(V3::zeros(), |s, x| s + x) / vertices.len() as f64;
+    let mut volume = 0.0;
+    for poly in faces.iter().chain(std::iter::once(&cap)) {
+        for k in 1..poly.len().saturating_sub(1) {
+            volume += (poly[0] - inner).dot(&(poly[k] - inner).cross(&(poly[k + 1] - inner))).abs() / 6.0;
+        }
+    }
+    if !(volume > 1e-9 * full[0]) {
+        return Err(RigidError::CrackLeavesNothing { crack: name, distance: tc.distance, volume, full_volume: full[0] });
+    }
+    let t = Truncated {
+        volume,
+        area_a: polygon_area(&faces[0]),
+        area_b: polygon_area(&faces[1]),
+        area_face: polygon_area(&faces[2]),
+        area_upper: polygon_area(&faces[3]),
+    };
+    let on_intersection = (fs[0] > 0.0 && fs[1] < 0.0).then(|| (o + (p - o) * (fs[0] / (fs[0] - fs[1]))).into());
+    let crack = CrackGeometry {
+        crack: *tc,
+        normal: nt.into(),
+        point: x0.into(),
+        trace_length_a: trace_length,
+        on_intersection,
+        removed: (0..4).filter(|&i| fs[i] < 0.0).map(|i| names[i].to_string()).collect(),
+        vertices: vertices.iter().map(|&x| x.into()).collect(),
+        area_crack: polygon_area(&cap),
+        full_volume: full[0],
+        full_area_a: full[1],
+        full_area_b: full[2],
+    };
+    Ok((t, crack))
+}
+
+/// Area of a planar polygon (vertices in order) [m²].
+fn polygon_area(poly: &[V3]) -> f64 {
+    if poly.len() < 3 {
+        return 0.0;
+    }
+    let mut s = V3::zeros();
+    for k in 1..poly.len() - 1 {
+        s += (poly[k] - poly[0]).cross(&(poly[k + 1] - poly[0]));
+    }
+    0.5 * s.norm()
 }
 
 /// Point on the planes a·x = 0, b·x = 0, c·x = d.
@@ -553,10 +793,31 @@ pub fn wedge_fs_report(input: &WedgeInput) -> Result<String, RigidError> {
     let _ = writeln!(s, "  {:<34} {}", "vertex P  (top of intersection) [m]", v(g.p));
     let _ = writeln!(s, "  {:<34} {}", "vertex QA (crest on A) [m]", v(g.qa));
     let _ = writeln!(s, "  {:<34} {}", "vertex QB (crest on B) [m]", v(g.qb));
-    let rows: [(&str, String); 14] = [
+    if let Some(c) = &g.crack {
+        let _ = writeln!(
+            s,
+            "  tension crack {} at L = {:.3} m behind the crest along the trace of A (|QA P| = {:.3} m); truncated wedge (cut off: {})",
+            c.crack.orientation,
+            c.crack.distance,
+            c.trace_length_a,
+            c.removed.join(", ")
+        );
+        let _ = writeln!(s, "  {:<34} {}", "crack on the upper slope X0 [m]", v(c.point));
+        if let Some(x) = c.on_intersection {
+            let _ = writeln!(s, "  {:<34} {}", "crack on the intersection [m]", v(x));
+        }
+    }
+    let mut rows: Vec<(&str, String)> = Vec::new();
+    if let Some(c) = &g.crack {
+        rows.push(("tetrahedron volume (no crack)", format!("{:.2} m3", c.full_volume)));
+        rows.push(("tetrahedron area A, B (no crack)", format!("{:.2}, {:.2} m2", c.full_area_a, c.full_area_b)));
+        rows.push(("area of the crack face", format!("{:.2} m2", c.area_crack)));
+    }
+    let volume_label = if g.crack.is_some() { "volume (truncated by the crack)" } else { "volume" };
+    rows.extend([
         ("line of intersection trend/plunge", format!("{:.2} / {:.2} deg", g.trend, g.plunge)),
         ("heights P, QA, QB above toe", format!("{:.3}, {:.3}, {:.3} m", g.height_intersection, g.height_crest_a, g.height_crest_b)),
-        ("volume", format!("{:.2} m3", g.volume)),
+        (volume_label, format!("{:.2} m3", g.volume)),
         ("weight", format!("{:.4} MN", r.weight / 1e6)),
         ("area A, B", format!("{:.2}, {:.2} m2", g.area_a, g.area_b)),
         ("area face, upper slope", format!("{:.2}, {:.2} m2", g.area_face, g.area_upper)),
@@ -574,7 +835,7 @@ pub fn wedge_fs_report(input: &WedgeInput) -> Result<String, RigidError> {
                 None => "none (this azimuth does not destabilise)".into(),
             },
         ),
-    ];
+    ]);
     for (k, val) in rows {
         let _ = writeln!(s, "  {k:<34} {val}");
     }

@@ -155,6 +155,65 @@ fn wedge_fs_bad_input_names_the_quantity() {
     assert_clean_failure(&o, &["nope.json"]);
 }
 
+#[test]
+fn wedge_fs_tension_crack_flags_and_file() {
+    // Reference: shared refs hoek_bray_wedge.py clipped_wedge_fs() (crack 70/165, L = 12.192 m,
+    // H1 = 30.48 m, dry): V 5003.621380283401 m3, FS 1.7369230728038687 (as in tests/all/rigid.rs).
+    let dir = scratch("cli/wedge_fs_crack");
+    let base = ["wedge-fs", "--height-def", "crest-on-a", "--H", "30.48"];
+    let o = jointquake(&[&base[..], &["--crack", "70/165", "--crack-distance", "12.192"]].concat(), &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = stdout(&o);
+    for needle in [
+        "tension crack 70/165 at L = 12.192 m behind the crest along the trace of A (|QA P| = 44.918 m)",
+        "volume (truncated by the crack)    5003.62 m3",
+        "tetrahedron volume (no crack)      6510.76 m3",
+        "FS                                 1.7369",
+    ] {
+        assert!(t.contains(needle), "lacks {needle:?}:\n{t}");
+    }
+    // The same crack from the --input file, JSON output.
+    std::fs::write(
+        dir.join("w.json"),
+        r#"{"height_def": "crest_on_a", "height": 30.48, "tension_crack": {"orientation": {"dip": 70, "dip_direction": 165}, "distance": 12.192}}"#,
+    )
+    .unwrap();
+    let o = jointquake(&["wedge-fs", "--input", "w.json", "--json"], &dir);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!(rel(v["fs"].as_f64().unwrap(), 1.7369230728038687) < 1e-6, "{}", v["fs"]);
+    assert!(rel(v["geometry"]["volume"].as_f64().unwrap(), 5003.621380283401) < 1e-6);
+    assert_eq!(v["geometry"]["crack"]["removed"], json!(["P"]));
+    assert_eq!(v["input"]["tension_crack"]["distance"], 12.192);
+    assert!(rel(v["strength_reduction_factor"].as_f64().unwrap(), 1.7369230728038687) < 1e-6);
+    // A flag overrides one part of the file's crack: L = 0 (crack through the crest point
+    // QA), HB clipped_wedge_fs(L=0.0) FS 1.7475504149831675.
+    let o = jointquake(&["wedge-fs", "--input", "w.json", "--crack-distance", "0", "--json"], &dir);
+    let v: Value = serde_json::from_str(&stdout(&o)).unwrap_or_else(|_| panic!("{}", stderr(&o)));
+    assert!(rel(v["fs"].as_f64().unwrap(), 1.7475504149831675) < 1e-6, "{}", v["fs"]);
+    assert_eq!(v["input"]["tension_crack"]["orientation"]["dip"], 70.0);
+}
+
+#[test]
+fn wedge_fs_tension_crack_bad_input() {
+    let dir = scratch("cli/wedge_fs_crack_bad");
+    let o = jointquake(&["wedge-fs", "--crack", "70/165"], &dir);
+    assert_clean_failure(&o, &["--crack needs --crack-distance"]);
+    let o = jointquake(&["wedge-fs", "--crack-distance", "5"], &dir);
+    assert_clean_failure(&o, &["--crack-distance needs --crack"]);
+    let o = jointquake(&["wedge-fs", "--crack", "70-165", "--crack-distance", "5"], &dir);
+    assert_eq!(o.status.code(), Some(2), "malformed command line: {}", stderr(&o));
+    assert!(stderr(&o).contains("expected DIP/DIPDIR in degrees, e.g. 70/165"), "{}", stderr(&o));
+    // Beyond P (|QA P| = 44.918 m for the appendix wedge).
+    let o = jointquake(&["wedge-fs", "--height-def", "crest-on-a", "--H", "30.48", "--crack", "70/165", "--crack-distance", "50"], &dir);
+    assert_clean_failure(&o, &["tension crack 70/165 at L = 50 m does not cut the wedge", "0 <= L < 44.918 m"]);
+    let o = jointquake(&["wedge-fs", "--crack", "20/185", "--crack-distance", "12"], &dir);
+    assert_clean_failure(&o, &["tension crack 20/185", "cuts off the toe"]);
+    std::fs::write(dir.join("wet.json"), r#"{"water": "hoek_bray_short"}"#).unwrap();
+    let o = jointquake(&["wedge-fs", "--input", "wet.json", "--crack", "70/165", "--crack-distance", "12"], &dir);
+    assert_clean_failure(&o, &["wet.json", "dry wedge only"]);
+}
+
 /// Write a scene and run `jointquake <cmd> scene.json --out out`.
 fn cli_on_scene(test: &str, cmd: &str, scene: &Value) -> Output {
     let dir = scratch(&format!("cli/{test}"));

@@ -186,6 +186,173 @@ fn bad_wedge_inputs_are_typed_errors() {
     assert!(e.to_string().contains("wedge height H"), "{e}");
 }
 
+// ---------------------------------------------------------------- tension crack
+
+/// Hoek & Bray appendix wedge (H1 = 100 ft = 30.48 m on plane A, seed planes and strengths,
+/// dry) with a tension crack of orientation `crack` at L = `l` m behind the crest.
+fn crack_wedge(crack: (f64, f64), l: f64) -> WedgeInput {
+    WedgeInput {
+        height: 30.48,
+        height_def: HeightDef::CrestOnA,
+        tension_crack: Some(TensionCrack { orientation: PlaneOrientation::new(crack.0, crack.1), distance: l }),
+        ..WedgeInput::default()
+    }
+}
+
+#[test]
+fn tension_crack_appendix_wedge_matches_reference() {
+    // HB clipped_wedge_fs() (crack 70/165, L = 40 ft = 12.192 m, H1 = 30.48 m, dry; the
+    // script clips with scipy ConvexHull), full precision: V 5003.621380283401 m3,
+    // W 125806202.47310697 N, A_A 517.0061464085496 m2, A_B 597.1923910414582 m2,
+    // NA 100375143.40129727 N, NB 61624139.55927203 N, FS 1.7369230728038687.
+    // Tolerance 1e-6 relative (the brief). Untruncated: HB analyse(30.48, "H1") V 6510.75633342783.
+    let input = crack_wedge((70.0, 165.0), 12.192);
+    let r = analyse_wedge(&input).unwrap();
+    let g = &r.geometry;
+    let cases = [
+        ("volume", g.volume, 5003.621380283401),
+        ("weight", r.weight, 125806202.47310697),
+        ("A_A", g.area_a, 517.0061464085496),
+        ("A_B", g.area_b, 597.1923910414582),
+        ("NA", r.normal_a, 100375143.40129727),
+        ("NB", r.normal_b, 61624139.55927203),
+        ("FS", r.fs, 1.7369230728038687),
+    ];
+    for (name, got, want) in cases {
+        assert!(rel(got, want) < 1e-6, "{name}: {got} vs {want}");
+    }
+    let c = g.crack.as_ref().expect("crack geometry");
+    assert!(rel(c.full_volume, 6510.75633342783) < 1e-6);
+    assert_eq!(c.removed, ["P"]);
+    assert_eq!(c.vertices.len(), 6);
+    // Independent volume check: here the crack cuts off the tetrahedron P, X0 (on QA P),
+    // Y (on QB P), Z (on O P = the crack point on the line of intersection).
+    let v = |a: [f64; 3]| nalgebra::Vector3::from(a);
+    let (p, x0, z) = (v(g.p), v(c.point), v(c.on_intersection.unwrap()));
+    let qb = v(g.qb);
+    let on_pqb = |q: &nalgebra::Vector3<f64>| (q - p).cross(&(qb - p)).norm() < 1e-9 * (qb - p).norm_squared() && *q != qb;
+    let y = c.vertices.iter().map(|&q| v(q)).find(on_pqb).unwrap();
+    let removed = (x0 - p).dot(&(y - p).cross(&(z - p))).abs() / 6.0;
+    assert!(rel(c.full_volume - removed, g.volume) < 1e-12, "{} - {removed} vs {}", c.full_volume, g.volume);
+    // The friction-only FS does not depend on the size or truncation of the wedge (NA/W,
+    // NB/W and sin psi depend on the plane orientations only): the untruncated value.
+    let full = analyse_wedge(&WedgeInput { tension_crack: None, ..input.clone() }).unwrap();
+    assert!(rel(r.fs_friction_only, full.fs_friction_only) < 1e-12);
+    // Strength reduction and the pseudo-static coefficients use the truncated wedge.
+    assert!(rel(strength_reduction_factor(&input).unwrap(), r.fs) < 1e-9);
+    let k = wedge_seismic_coeffs(&input, 0.0, true).unwrap();
+    assert!(rel(k.mass, r.mass) < 1e-12 && rel(k.normal_a[0], r.normal_a) < 1e-12);
+    assert!(rel(k.r0(), (1.0 - r.fs) * r.driving_force / r.mass) < 1e-9);
+    let kc_full = critical_horizontal_acceleration(&WedgeInput { tension_crack: None, ..input.clone() }, 0.0).unwrap().unwrap();
+    let kc = k.critical_horizontal_acceleration().unwrap();
+    // Here the crack lowers kc along with the FS (1.7369 against 1.8480 untruncated).
+    assert!(kc < kc_full, "kc {kc} vs untruncated {kc_full}");
+    let text = wedge_fs_report(&input).unwrap();
+    for needle in ["tension crack 70/165 at L = 12.192 m", "5003.62 m3", "6510.76 m3", "517.01, 597.19", "1.7369", "cut off: P"] {
+        assert!(text.contains(needle), "report lacks {needle:?}:\n{text}");
+    }
+}
+
+#[test]
+fn tension_crack_cutting_off_two_vertices_matches_reference() {
+    // A crack 65/50 at L = 12.192 m cuts off P and QB (it crosses the slope face near QB):
+    // the clipped solid has a quadrilateral crack face. HB clipped_wedge_fs(crack=(65, 50)):
+    // V 2058.08889022916, A_A 457.33171544104914, A_B 151.76738853875696,
+    // NA 41286290.82595937, NB 25347233.005404912, FS 1.7879052480136142. 1e-6 relative.
+    let r = analyse_wedge(&crack_wedge((65.0, 50.0), 12.192)).unwrap();
+    let g = &r.geometry;
+    for (name, got, want) in [
+        ("volume", g.volume, 2058.08889022916),
+        ("A_A", g.area_a, 457.33171544104914),
+        ("A_B", g.area_b, 151.76738853875696),
+        ("NA", r.normal_a, 41286290.82595937),
+        ("NB", r.normal_b, 25347233.005404912),
+        ("FS", r.fs, 1.7879052480136142),
+    ] {
+        assert!(rel(got, want) < 1e-6, "{name}: {got} vs {want}");
+    }
+    assert_eq!(g.crack.as_ref().unwrap().removed, ["P", "QB"]);
+}
+
+#[test]
+fn tension_crack_limits_are_continuous() {
+    // L -> 0+: the crack passes through the crest point QA; HB clipped_wedge_fs(L=0.0)
+    // V 2613.702531405953, FS 1.7475504149831675 (and L = 1e-3: V 2613.9628044504366,
+    // FS 1.7475402774394837). L -> |QA P|-: the crack passes through P and cuts nothing,
+    // the full tetrahedron, HB analyse(30.48, "H1") V 6510.75633342783, FS 1.8479504209368582.
+    let at = |l: f64| analyse_wedge(&crack_wedge((70.0, 165.0), l)).unwrap();
+    let r0 = at(0.0);
+    assert!(rel(r0.geometry.volume, 2613.702531405953) < 1e-6 && rel(r0.fs, 1.7475504149831675) < 1e-6);
+    let r1 = at(1e-3);
+    assert!(rel(r1.geometry.volume, 2613.9628044504366) < 1e-6 && rel(r1.fs, 1.7475402774394837) < 1e-6);
+    let r = at(1e-9);
+    assert!(rel(r.geometry.volume, r0.geometry.volume) < 1e-8 && rel(r.fs, r0.fs) < 1e-8, "{} {}", r.geometry.volume, r.fs);
+    let trace = r0.geometry.crack.as_ref().unwrap().trace_length_a;
+    assert!(rel(trace, 44.91783293312746) < 1e-9, "|QA P| {trace}");
+    let end = at(trace * (1.0 - 1e-6));
+    assert!(rel(end.geometry.volume, 6510.75633342783) < 1e-6 && rel(end.fs, 1.8479504209368582) < 1e-6);
+    // The volume grows with L.
+    let vols: Vec<f64> = (0..=20).map(|i| at(trace * i as f64 / 20.5).geometry.volume).collect();
+    assert!(vols.windows(2).all(|w| w[1] > w[0]), "{vols:?}");
+    // A crack parallel to the slope face: a slab along the face, which vanishes as L -> 0.
+    let slab = |l: f64| analyse_wedge(&crack_wedge((65.0, 185.0), l));
+    let small = slab(1e-3).unwrap();
+    assert!(small.geometry.volume > 0.0 && small.geometry.volume < 1.0, "{}", small.geometry.volume);
+    assert!(small.fs.is_finite() && small.fs > 1.0);
+}
+
+#[test]
+fn tension_crack_errors_name_the_crack() {
+    let err = |c: (f64, f64), l: f64| analyse_wedge(&crack_wedge(c, l)).unwrap_err();
+    // Beyond P (|QA P| = 44.918 m): the crack misses the wedge along the trace of A.
+    for l in [44.91783293312746, 50.0, 1e3] {
+        let e = err((70.0, 165.0), l);
+        assert!(matches!(e, RigidError::CrackMissesWedge { .. }), "{e:?}");
+        let t = e.to_string();
+        assert!(t.contains("70/165") && t.contains("does not cut the wedge") && t.contains("0 <= L < 44.918"), "{t}");
+    }
+    // A gentle crack dipping towards the face (20/185) passes in front of the toe.
+    let e = err((20.0, 185.0), 12.192);
+    assert!(matches!(e, RigidError::CrackCutsOffToe { .. }), "{e:?}");
+    assert!(e.to_string().contains("20/185") && e.to_string().contains("toe O"), "{e}");
+    // A crack along the slope face at L = 0 leaves nothing.
+    let e = err((65.0, 185.0), 0.0);
+    assert!(matches!(e, RigidError::CrackLeavesNothing { .. }), "{e:?}");
+    assert!(e.to_string().contains("65/185") && e.to_string().contains("larger L"), "{e}");
+    // Water with a crack is not supported (typed error saying what is).
+    let wet = WedgeInput { water: Water::HoekBrayShort, ..crack_wedge((70.0, 165.0), 12.192) };
+    let e = analyse_wedge(&wet).unwrap_err();
+    assert!(matches!(e, RigidError::CrackWithWater { .. }), "{e:?}");
+    assert!(e.to_string().contains("dry wedge only"), "{e}");
+    assert!(matches!(strength_reduction_factor(&wet), Err(RigidError::CrackWithWater { .. })));
+    assert!(matches!(wedge_seismic_coeffs(&wet, 0.0, true), Err(RigidError::CrackWithWater { .. })));
+    // Bad numbers.
+    let e = err((70.0, 165.0), -1.0);
+    assert!(e.to_string().contains("tension crack distance L behind the crest [m] = -1"), "{e}");
+    let e = err((95.0, 165.0), 12.0);
+    assert!(e.to_string().contains("tension crack dip"), "{e}");
+    // A vertical crack containing the trace of A (t3 = (0.0512, 0.9777, 0.2036), its
+    // horizontal direction has azimuth 3.0 deg) cannot be placed by L.
+    let g = analyse_wedge(&crack_wedge((70.0, 165.0), 1.0)).unwrap().geometry;
+    let (p, qa) = (g.p, g.qa);
+    let az = (p[0] - qa[0]).atan2(p[1] - qa[1]).to_degrees();
+    let e = err((90.0, az + 90.0), 12.0);
+    assert!(matches!(e, RigidError::InvalidInput { .. }) && e.to_string().contains("trace of plane A"), "{e:?}");
+}
+
+#[test]
+fn tension_crack_serde() {
+    let input = crack_wedge((70.0, 165.0), 12.192);
+    let json = serde_json::to_string(&input).unwrap();
+    assert!(json.contains(r#""tension_crack":{"orientation":{"dip":70.0,"dip_direction":165.0},"distance":12.192}"#), "{json}");
+    assert_eq!(serde_json::from_str::<WedgeInput>(&json).unwrap(), input);
+    // Without a crack nothing is written (older inputs and results are unchanged).
+    assert!(!serde_json::to_string(&WedgeInput::default()).unwrap().contains("tension_crack"));
+    assert!(!serde_json::to_string(&analyse_wedge(&WedgeInput::default()).unwrap()).unwrap().contains("crack"));
+    let typo = r#"{"tension_crack": {"orientation": {"dip": 70, "dip_direction": 165}, "distanse": 12}}"#;
+    assert!(serde_json::from_str::<WedgeInput>(typo).unwrap_err().to_string().contains("unknown field `distanse`"));
+}
+
 // ---------------------------------------------------------------- Newmark sliding
 
 /// AN section A incline: beta 30, phi 35, no cohesion.
