@@ -196,6 +196,8 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
             for p in &mut r.pairs {
                 p.slip = 0.0;
                 p.d_t = [0.0; 2];
+                // the softening of a bond counts the slip of the earthquake, not of settling
+                p.hist.slip = 0.0;
             }
         }
         Some(eq)

@@ -374,6 +374,10 @@ pub struct JointSceneSpec {
     /// Keep cohesion after slip/opening. Default false.
     #[serde(default)]
     pub keep_cohesion: Option<bool>,
+    /// Softening length [m]: cohesion falls linearly to 0 over this accumulated slip (and an
+    /// opening beyond it breaks the bond). Default 0: brittle, lost at the first slip or opening.
+    #[serde(default)]
+    pub softening_slip: Option<f64>,
     /// Tied (bonded, never opens or slides). Default false.
     #[serde(default)]
     pub tied: Option<bool>,

@@ -77,6 +77,7 @@ impl ContactJoint {
             keep_cohesion: spec.keep_cohesion.unwrap_or(false),
             tied: spec.tied.unwrap_or(false),
             open_tolerance: 0.0,
+            softening_slip: spec.softening_slip.unwrap_or(0.0),
         };
         law.validate().map_err(|e| bad(e.to_string()))?;
         let method = match spec.method.as_deref().unwrap_or("nts") {

@@ -64,6 +64,14 @@ pub struct JointLaw {
     /// together and the trial gap is the initial gap, ±1e-16 m, whose sign is noise.
     #[serde(default)]
     pub open_tolerance: f64,
+    /// Softening length d_c (m, ≥ 0): while the bond is intact its cohesion falls linearly from
+    /// c A to 0 as the pair's accumulated slip grows from 0 to d_c, where the bond is lost; an
+    /// opening beyond d_c also breaks it. Default 0: brittle, lost at the first slip or opening
+    /// beyond round-off (design §5). A few millimetres model the breakage of asperities over a
+    /// finite shear displacement, and keep a joint's cohesion from being lost all at once by the
+    /// elastic creep of its edges, where the loading path concentrates shear.
+    #[serde(default)]
+    pub softening_slip: f64,
 }
 
 /// Round-off scale of a gap, relative to the largest coordinate magnitude of the joint (plus
@@ -74,7 +82,7 @@ pub const OPEN_TOLERANCE_RELATIVE: f64 = 1e-12;
 impl JointLaw {
     /// Pure Coulomb friction μ: no cohesion, no tension, brittle defaults.
     pub fn coulomb(mu: f64) -> Self {
-        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false, open_tolerance: 0.0 }
+        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false, open_tolerance: 0.0, softening_slip: 0.0 }
     }
 
     /// A glued (tied) interface.
@@ -85,7 +93,7 @@ impl JointLaw {
     /// Check that every parameter is finite and non-negative; the error names the field.
     pub fn validate(&self) -> Result<(), JointLawError> {
         for (field, value) in
-            [("mu", self.mu), ("cohesion", self.cohesion), ("tensile_strength", self.tensile_strength), ("open_tolerance", self.open_tolerance)]
+            [("mu", self.mu), ("cohesion", self.cohesion), ("tensile_strength", self.tensile_strength), ("open_tolerance", self.open_tolerance), ("softening_slip", self.softening_slip)]
         {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(JointLawError { field, value });
@@ -98,11 +106,34 @@ impl JointLaw {
 /// An invalid joint-law parameter.
 #[derive(Clone, Debug, PartialEq, Error)]
 #[error(
-    "joint law: `{field}` = {value} must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa, open_tolerance in m)"
+    "joint law: `{field}` = {value} must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa, open_tolerance and softening_slip in m)"
 )]
 pub struct JointLawError {
     pub field: &'static str,
     pub value: f64,
+}
+
+impl JointLaw {
+    /// The cohesive force of a pair (N): c A while intact, softened linearly with the
+    /// accumulated slip over [`JointLaw::softening_slip`]; 0 once the bond is lost.
+    pub fn cohesion_force(&self, hist: &PairHistory, area: f64) -> f64 {
+        if !hist.intact {
+            return 0.0;
+        }
+        let c = self.cohesion * area;
+        if self.softening_slip > 0.0 && !self.keep_cohesion { c * (1.0 - hist.slip / self.softening_slip).max(0.0) } else { c }
+    }
+
+    /// Whether a trial gap `g` (m) opens the pair far enough to break its bond.
+    fn breaks_by_opening(&self, g: f64) -> bool {
+        g > self.open_tolerance.max(self.softening_slip)
+    }
+
+    /// Whether a slip increment of norm `d` (m) bringing the accumulated slip to `total` breaks
+    /// the bond.
+    fn breaks_by_slip(&self, d: f64, total: f64) -> bool {
+        if self.softening_slip > 0.0 { total >= self.softening_slip } else { d > self.open_tolerance }
+    }
 }
 
 /// The state of a pair after a step.
@@ -201,8 +232,7 @@ pub fn pair_force(
     }
     let bonded = hist.intact && law.tensile_strength > 0.0;
     if g_trial >= 0.0 && !bonded {
-        let opened = g_trial > law.open_tolerance;
-        let intact = hist.intact && (law.keep_cohesion || !opened);
+        let intact = hist.intact && (law.keep_cohesion || !law.breaks_by_opening(g_trial));
         return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
     }
     let r_n = -g_trial / k;
@@ -211,8 +241,7 @@ pub fn pair_force(
         return PairResponse::open(PairHistory { intact: false, ..*hist }, dt_trial);
     }
     let r_trial = -dt_trial / k;
-    let cohesion = if hist.intact { law.cohesion * area } else { 0.0 };
-    let limit = (law.mu * r_n + cohesion).max(0.0);
+    let limit = (law.mu * r_n + law.cohesion_force(hist, area)).max(0.0);
     let r_trial_norm = r_trial.norm();
     if r_trial_norm <= limit {
         let state = if bonded { PairState::Bonded } else { PairState::Stick };
@@ -222,8 +251,8 @@ pub fn pair_force(
     // round-off (`open_tolerance`) does not break the bond.
     let r_t = r_trial * (limit / r_trial_norm);
     let slip_increment = dt_trial + r_t * k;
-    let slipped = slip_increment.norm() > law.open_tolerance;
-    let intact = hist.intact && (law.keep_cohesion || !slipped);
+    let slip = hist.slip + slip_increment.norm();
+    let intact = hist.intact && (law.keep_cohesion || !law.breaks_by_slip(slip_increment.norm(), slip));
     if hist.intact && !intact && r_n < 0.0 {
         // The slip broke the bond of a pair in tension: with its new history it is open.
         return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
@@ -232,7 +261,7 @@ pub fn pair_force(
         r_n,
         r_t,
         state: PairState::Slip,
-        hist: PairHistory { intact, slip: hist.slip + slip_increment.norm() },
+        hist: PairHistory { intact, slip },
         slip_increment,
     }
 }
@@ -266,22 +295,20 @@ pub fn penalty_force(
     }
     let bonded = hist.intact && law.tensile_strength > 0.0;
     if gap >= 0.0 && !bonded {
-        let opened = gap > law.open_tolerance;
-        let intact = hist.intact && (law.keep_cohesion || !opened);
+        let intact = hist.intact && (law.keep_cohesion || !law.breaks_by_opening(gap));
         return PairResponse::open(PairHistory { intact, ..*hist }, dd_t);
     }
     let r_n = -kn_a * gap;
     if r_n < -law.tensile_strength * area {
         return PairResponse::open(PairHistory { intact: false, ..*hist }, dd_t);
     }
-    let cohesion = if hist.intact { law.cohesion * area } else { 0.0 };
-    let limit = (law.mu * r_n + cohesion).max(0.0);
+    let limit = (law.mu * r_n + law.cohesion_force(hist, area)).max(0.0);
     let r_trial_norm = r_trial.norm();
     if r_trial_norm <= limit {
         let state = if bonded { PairState::Bonded } else { PairState::Stick };
         return PairResponse { r_n, r_t: r_trial, state, hist: *hist, slip_increment: dd_t };
     }
-    let intact = hist.intact && law.keep_cohesion;
+    let intact = hist.intact && (law.keep_cohesion || (law.softening_slip > 0.0 && hist.slip + dd_t.norm() < law.softening_slip));
     if hist.intact && !intact && r_n < 0.0 {
         return PairResponse::open(PairHistory { intact, ..*hist }, dd_t);
     }
@@ -304,7 +331,7 @@ mod tests {
     const AREA: f64 = 0.25;
 
     fn law(mu: f64, c: f64, st: f64) -> JointLaw {
-        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false, open_tolerance: 0.0 }
+        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false, open_tolerance: 0.0, softening_slip: 0.0 }
     }
 
     #[test]
@@ -475,6 +502,40 @@ mod tests {
         assert!(p.hist.intact, "an exactly touching penalty pair keeps its bond");
         let p = penalty_force(&l, &PairHistory::default(), 2e-12, Vector2::zeros(), Vector2::zeros(), 1e9, 1e9, AREA);
         assert!(!p.hist.intact);
+    }
+
+    #[test]
+    fn cohesion_softens_linearly_over_the_softening_slip() {
+        // Reference: c_eff = c A (1 − s/d_c) while s < d_c, 0 after; the limit is μ r_n + c_eff
+        // exactly (relative 1e-12, round-off of the scaling). d_c = 1 mm, c A = 2.5e4 N.
+        let l = JointLaw { softening_slip: 1e-3, ..law(0.5, 1e5, 0.0) };
+        let g = -1e-8; // closing: r_n = 1e-8 / DT2W
+        let r_n = -g / DT2W;
+        let push = Vector2::new(1.0, 0.0); // a large trial slip: the pair slips at its limit
+        for s in [0.0, 2.5e-4, 5e-4, 9e-4] {
+            let h = PairHistory { intact: true, slip: s };
+            let r = pair_force(&l, &h, g, push, DT2W, AREA);
+            let expected = 0.5 * r_n + 1e5 * AREA * (1.0 - s / 1e-3);
+            assert_eq!(r.state, PairState::Slip);
+            assert!((r.r_t.norm() - expected).abs() < 1e-12 * expected, "s = {s}: {} vs {expected}", r.r_t.norm());
+            // this slip (about 1 m) takes the pair past d_c: the bond is gone
+            assert!(!r.hist.intact);
+        }
+        // a trial slip of 0.1 mm (well above the limit, so the pair slips about 0.097 mm) keeps
+        // the total below d_c: the bond stays, softened
+        let r = pair_force(&l, &PairHistory::default(), g, Vector2::new(1e-4, 0.0), DT2W, AREA);
+        assert_eq!(r.state, PairState::Slip);
+        assert!(r.hist.intact && r.hist.slip > 9e-5 && r.hist.slip < 1e-4, "slip {}", r.hist.slip);
+        // an opening within d_c keeps the bond, beyond it breaks it
+        let r = pair_force(&l, &PairHistory::default(), 5e-4, Vector2::zeros(), DT2W, AREA);
+        assert_eq!((r.state, r.hist.intact), (PairState::Open, true));
+        let r = pair_force(&l, &PairHistory::default(), 2e-3, Vector2::zeros(), DT2W, AREA);
+        assert_eq!((r.state, r.hist.intact), (PairState::Open, false));
+        // brittle (d_c = 0) is unchanged: any slip beyond round-off ends the bond
+        let b = law(0.5, 1e5, 0.0);
+        let r = pair_force(&b, &PairHistory::default(), g, push, DT2W, AREA);
+        assert!((r.r_t.norm() - (0.5 * r_n + 1e5 * AREA)).abs() < 1e-12 * r.r_t.norm());
+        assert!(!r.hist.intact);
     }
 
     #[test]

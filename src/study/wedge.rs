@@ -153,11 +153,20 @@ pub struct MonitorNames {
     pub p1: String,
     pub p2_wedge: String,
     pub p2_rock: String,
+    /// A rock node inside the rock mass under the wedge (off the joint, whose master nodes
+    /// carry the contact impulses): the motion the rock delivers to the wedge. Optional in the
+    /// scene; default "R".
+    #[serde(default = "default_rock_monitor")]
+    pub rock: String,
+}
+
+fn default_rock_monitor() -> String {
+    "R".into()
 }
 
 impl Default for MonitorNames {
     fn default() -> Self {
-        MonitorNames { p1: "P1".into(), p2_wedge: "P2w".into(), p2_rock: "P2r".into() }
+        MonitorNames { p1: "P1".into(), p2_wedge: "P2w".into(), p2_rock: "P2r".into(), rock: default_rock_monitor() }
     }
 }
 

@@ -25,11 +25,12 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// A monitored point's history: time and displacement.
+/// A monitored point's history: time, displacement and acceleration (relative to the base).
 #[derive(Clone, Debug, Default)]
 pub struct PointHistory {
     pub t: Vec<f64>,
     pub u: Vec<[f64; 3]>,
+    pub a: Vec<[f64; 3]>,
 }
 
 /// Read a history CSV written by [`crate::output::history`] (`#` header, then
@@ -49,14 +50,15 @@ pub fn read_point_history(path: &Path) -> Result<PointHistory, Error> {
             }
             continue;
         }
-        let v: Vec<f64> = line.split(',').take(4).map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| {
+        let v: Vec<f64> = line.split(',').take(10).map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| {
             ModelError::Invalid(format!("{}: line {}: {e} in `{line}`", path.display(), ln + 1))
         })?;
-        if v.len() < 4 {
-            return Err(ModelError::Invalid(format!("{}: line {}: fewer than 4 columns", path.display(), ln + 1)).into());
+        if v.len() < 10 {
+            return Err(ModelError::Invalid(format!("{}: line {}: fewer than 10 columns (t, u, v, a)", path.display(), ln + 1)).into());
         }
         h.t.push(v[0]);
         h.u.push([v[1], v[2], v[3]]);
+        h.a.push([v[7], v[8], v[9]]);
     }
     if h.t.is_empty() {
         return Err(ModelError::Invalid(format!("{}: no history rows (did the run stop before its first step?)", path.display())).into());
@@ -113,6 +115,12 @@ pub struct RunResult {
     pub max_opening: Vec<(String, f64)>,
     /// Slave node-steps that found no master face (search event `lost`), per joint.
     pub lost_node_steps: Vec<(String, u64)>,
+    /// Peak absolute acceleration of the rock monitor (x, y, z) [g], if the scene has it: the
+    /// motion the rock delivers under the wedge, to compare with the PGA.
+    pub rock_peak_accel: Option<[f64; 3]>,
+    /// Residual slip of the rigid block driven by the rock monitor's computed absolute motion
+    /// (cohesion lost at first slide) [m]: the rigid level with the FEM's site response.
+    pub rigid_on_rock_slip: Option<f64>,
     /// Slip history (t, slip) sampled for charts (at most about 2000 points).
     #[serde(skip)]
     pub slip_history: Vec<(f64, f64)>,
@@ -212,6 +220,36 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
         }
     }
     let mode = classify_mode(&slip, &joints, residual, line_length);
+    // the rock's own motion under the wedge (absolute = relative + ground)
+    let (mut rock_peak_accel, mut rigid_on_rock_slip) = (None, None);
+    let rock_csv = dir.join("histories").join(format!("{}.csv", study.monitors.rock));
+    if rock_csv.exists() {
+        let rh = read_point_history(&rock_csv)?;
+        let scene = Scene::load(&out.join("scenes").join(format!("{}.json", spec.id)))?;
+        let (motions, _) = base_motions(&scene)?;
+        let abs: Vec<[f64; 3]> = rh
+            .t
+            .iter()
+            .zip(&rh.a)
+            .map(|(&t, a)| {
+                let g = crate::dynamics::loads::ground_acceleration_of(&motions, t);
+                [a[0] + g[0], a[1] + g[1], a[2] + g[2]]
+            })
+            .collect();
+        let mut pk = [0.0f64; 3];
+        for a in &abs {
+            for c in 0..3 {
+                pk[c] = pk[c].max(a[c].abs() / scene.g);
+            }
+        }
+        rock_peak_accel = Some(pk);
+        if rh.t.len() > 2 {
+            let dt = rh.t[1] - rh.t[0];
+            if let Ok(r) = rigid_wedge_slip(&study.wedge, &abs, dt, Bond::Brittle, false) {
+                rigid_on_rock_slip = Some(r.result.residual_displacement);
+            }
+        }
+    }
     let p1_h: Vec<(f64, [f64; 3])> = p1.t.iter().zip(&p1.u).map(|(&t, u)| (t, [u[0] - u0[0], u[1] - u0[1], u[2] - u0[2]])).collect();
     Ok(RunResult {
         spec: spec.clone(),
@@ -228,6 +266,8 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
         mode,
         max_opening,
         lost_node_steps: lost,
+        rock_peak_accel,
+        rigid_on_rock_slip,
         slip_history: thin(&slip, 2000),
         p1_history: thin(&p1_h, 2000),
     })
@@ -478,7 +518,13 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let mat = base.materials.iter().map(|mm| format!("`{}` E = {} GPa, ν = {}, ρ = {} kg/m³", mm.group, mm.e / 1e9, mm.nu, mm.rho)).collect::<Vec<_>>().join("; ");
     let _ = writeln!(md, "- Geometry `geo/wedge.geo` (planes A 45/105, B 70/235, face 65/185, upper slope 12/195; H = {} m as the vertical rise of the line of intersection); mesh levels: {}.", study.wedge.height, study.meshes.iter().map(|l| format!("{} ({})", l.name, l.set.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))).collect::<Vec<_>>().join("; "));
     let _ = writeln!(md, "- Materials: {mat}. The seed gives no elastic constants; these are chosen (a moderately jointed rock mass) and the sensitivity to E is below.");
-    let _ = writeln!(md, "- Joints: A φ = 20°, c = 24 kPa; B φ = 30°, c = 48 kPa (seed table 1). Cohesion is lost at a pair's first slip or opening (brittle); during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).");
+    let dc = base.joints.iter().filter_map(|j| j.softening_slip).fold(0.0, f64::max);
+    let loss = if dc > 0.0 {
+        format!("Cohesion is lost after slip: it softens linearly to zero over d_c = {} mm of a pair's accumulated slip (and an opening beyond d_c breaks it)", dc * 1e3)
+    } else {
+        "Cohesion is lost at a pair's first slip or opening (brittle)".to_string()
+    };
+    let _ = writeln!(md, "- Joints: A φ = 20°, c = 24 kPa; B φ = 30°, c = 48 kPa (seed table 1). {loss}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).");
     let grav = base.loads.gravity.as_ref().and_then(|g| g.groups.clone()).map(|g| g.join(", ")).unwrap_or_else(|| "all".into());
     let _ = writeln!(md, "- Gravity on: {grav} (the rock is a weightless support, as in limit equilibrium); brought to equilibrium before the record.");
     let recs = base.loads.base.iter().map(|b| format!("`{}` along ({}, {}, {}) × {}", b.record.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(), b.direction[0], b.direction[1], b.direction[2], b.pga.map(|p| format!("PGA {p} g")).or(b.scale.map(|s| format!("scale {s}"))).unwrap_or_else(|| "1".into()))).collect::<Vec<_>>().join("; ");
@@ -532,6 +578,19 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     for s in &trend {
         let _ = writeln!(md, "- {s}");
     }
+    let _ = writeln!(md);
+
+    let _ = writeln!(md, "## The rock's response under the wedge\n");
+    let _ = writeln!(md, "Peak absolute acceleration of the rock node `{}` below the line of intersection (NTS-L1 runs, {sweep} mesh) against the PGA, and the rigid block driven by that computed motion instead of the base record (cohesion lost at the first slide): the part of the FEM slip that the rock's own response explains.\n", study.monitors.rock);
+    let mut t = Table::new(["PGA [g]", "rock peak x / y / z [g]", "amplification y / PGA", "rigid block on the base record", "rigid block on the rock's motion", "FEM NTS-L1"]);
+    for &p in &study.pga {
+        if let Some(r) = find(&runs, |s| plain(s) && s.pga == p && s.method == "nts" && s.mesh == sweep && s.layer == 1) {
+            let pk = r.rock_peak_accel.map(|a| format!("{} / {} / {}", m(a[0]), m(a[1]), m(a[2]))).unwrap_or_else(|| "–".into());
+            let amp = r.rock_peak_accel.map(|a| m(a[1] / p)).unwrap_or_else(|| "–".into());
+            let _ = t.push_row([m(p), pk, amp, m(rigid_of(p).brittle.result.residual_displacement), r.rigid_on_rock_slip.map(m).unwrap_or_else(|| "–".into()), m(r.residual_slip)]);
+        }
+    }
+    md.push_str(&t.to_markdown());
     let _ = writeln!(md);
 
     let _ = writeln!(md, "## Rock stiffness and rigid rock (PGA {acc} g, NTS-L1, {sweep} mesh)\n");
