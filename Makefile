@@ -17,7 +17,7 @@ JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures wedge wedge-report
+.PHONY: demo test venv build mesh run bench clean fixtures wedge wedge3 wedge-report
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -86,6 +86,15 @@ wedge: venv build
 	$(BIN) study plan $(STUDY) --bin $(CURDIR)/$(BIN)
 	$(MAKE) --no-print-directory -j$(JOBS) -f out/wedge/runs.mk all
 	$(BIN) study report $(STUDY)
+
+# The same study with the three-component El Centro 1940 (PEER RSN6: 180 along y, 270 along x,
+# UP along z, scaled together) when ../shared/records is present (medium mesh only).
+EC3 := ../shared/records/elcentro1940_RSN6_ELC180.txt
+wedge3: venv build
+	@if [ ! -f $(EC3) ]; then echo "make wedge3: $(EC3) is not here; this study needs the three-component El Centro records"; exit 1; fi
+	$(BIN) study plan pipelines/wedge_elcentro3_study.json --bin $(CURDIR)/$(BIN)
+	$(MAKE) --no-print-directory -j$(JOBS) -f out/wedge_elcentro3/runs.mk all
+	$(BIN) study report pipelines/wedge_elcentro3_study.json
 
 # Only the report, from the runs already in out/wedge.
 wedge-report: build
