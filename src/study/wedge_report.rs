@@ -100,6 +100,8 @@ fn read_joint_counts(path: &Path) -> Result<JointCounts, Error> {
 pub struct RunResult {
     pub spec: RunSpec,
     pub level: String,
+    /// The error that stopped the run (its histories end there), if any.
+    pub failed: Option<String>,
     pub nodes: usize,
     pub elements: usize,
     pub dt: f64,
@@ -192,6 +194,7 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
     let sp = dir.join("summary.json");
     let text = std::fs::read_to_string(&sp).map_err(|e| OutputError::read(&sp, e))?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| ModelError::Invalid(format!("{}: {e}", sp.display())))?;
+    let failed = std::fs::read_to_string(dir.join("failed.txt")).ok().map(|t| t.trim().to_string());
     let f = |k: &str| v[k].as_f64().unwrap_or(f64::NAN);
     let hist = |name: &str| read_point_history(&dir.join("histories").join(format!("{name}.csv")));
     let (w, r, p1) = (hist(&study.monitors.p2_wedge)?, hist(&study.monitors.p2_rock)?, hist(&study.monitors.p1)?);
@@ -209,15 +212,30 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
     let mut joints = Vec::new();
     let mut max_opening = Vec::new();
     let mut lost = Vec::new();
-    if let Some(js) = v["joints"].as_array() {
-        for j in js {
-            let name = j["name"].as_str().unwrap_or("?").to_string();
-            let c = read_joint_counts(&dir.join("histories").join(format!("joint_{name}.csv")))?;
-            max_opening.push((name.clone(), j["max_opening"].as_f64().unwrap_or(c.max_opening)));
-            lost.push((name.clone(), j["events"]["lost"].as_u64().unwrap_or(0)));
-            let n = j["slave_nodes"].as_u64().unwrap_or(0) as usize;
-            joints.push((name, c, n));
+    // joint names: from the summary, or (a failed run has none) from the joint histories
+    let names: Vec<(String, u64, Option<f64>, usize)> = match v["joints"].as_array() {
+        Some(js) => js
+            .iter()
+            .map(|j| (j["name"].as_str().unwrap_or("?").to_string(), j["events"]["lost"].as_u64().unwrap_or(0), j["max_opening"].as_f64(), j["slave_nodes"].as_u64().unwrap_or(0) as usize))
+            .collect(),
+        None => {
+            let mut n: Vec<(String, u64, Option<f64>, usize)> = std::fs::read_dir(dir.join("histories"))
+                .map(|rd| {
+                    rd.filter_map(|e| e.ok())
+                        .filter_map(|e| e.file_name().to_str().and_then(|f| f.strip_prefix("joint_")).and_then(|f| f.strip_suffix(".csv")).map(|f| f.to_string()))
+                        .map(|name| (name, 0, None, 0))
+                        .collect()
+                })
+                .unwrap_or_default();
+            n.sort_by(|a, b| a.0.cmp(&b.0));
+            n
         }
+    };
+    for (name, l, mo, n) in names {
+        let c = read_joint_counts(&dir.join("histories").join(format!("joint_{name}.csv")))?;
+        max_opening.push((name.clone(), mo.unwrap_or(c.max_opening)));
+        lost.push((name.clone(), l));
+        joints.push((name, c, n));
     }
     let mode = classify_mode(&slip, &joints, residual, line_length);
     // the rock's own motion under the wedge (absolute = relative + ground)
@@ -254,6 +272,7 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
     Ok(RunResult {
         spec: spec.clone(),
         level: spec.level(),
+        failed,
         nodes: v["nodes"].as_u64().unwrap_or(0) as usize,
         elements: v["elements"].as_u64().unwrap_or(0) as usize,
         dt: f("dt"),
@@ -392,22 +411,32 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let is_ref = |s: &RunSpec| s.mesh == reference && s.method == "nts" && s.layer == study.reference.layer && s.e_factor == 1.0 && !s.rigid_rock;
     let plain = |s: &RunSpec| s.e_factor == 1.0 && !s.rigid_rock;
 
-    // ---- chart: slip against PGA
-    let pts = |method: &str, mesh: &str, layer: u8| -> Vec<(f64, f64)> {
+    // ---- chart: slip against PGA (finished runs only; a failed run is listed in the tables)
+    let pts = |method: &str, mesh: &str, layer: u8, rigid_rock: bool| -> Vec<(f64, f64)> {
         study
             .pga
             .iter()
-            .filter_map(|&p| find(&runs, |s| plain(s) && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer).map(|r| (p, r.residual_slip.abs())))
+            .filter_map(|&p| {
+                find(&runs, |s| s.e_factor == 1.0 && s.rigid_rock == rigid_rock && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer)
+                    .filter(|r| r.failed.is_none())
+                    .map(|r| (p, r.residual_slip.abs()))
+            })
             .collect()
     };
-    let nts_sweep = pts("nts", &sweep, 1);
-    let ntn_sweep = pts("ntn", &sweep, 1);
-    let reference_pts = pts("nts", &reference, study.reference.layer);
-    let mut c = Chart::new(format!("Residual slip at P2 against PGA ({} record set)", base.name()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+    let nts_sweep = pts("nts", &sweep, 1, false);
+    let ntn_sweep = pts("ntn", &sweep, 1, false);
+    let nts_rigid_rock = pts("nts", &sweep, 1, true);
+    let ntn_rigid_rock = pts("ntn", &sweep, 1, true);
+    let reference_pts = pts("nts", &reference, study.reference.layer, false);
+    let mut c = Chart::new(format!("Residual slip at P2 against PGA ({})", base.name()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
     c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), nts_sweep.clone()));
     c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), ntn_sweep.clone()));
     if reference != sweep {
         c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh (reference)", study.reference.layer), reference_pts.clone()));
+    }
+    if !nts_rigid_rock.is_empty() {
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, rigid rock"), nts_rigid_rock.clone()));
+        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, rigid rock"), ntn_rigid_rock.clone()));
     }
     c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", study.pga.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement))));
     c.series.push(Series::line_markers("rigid block, cohesion kept", study.pga.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement))));
@@ -445,7 +474,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let ref_slip = ref_acc.map(|r| r.residual_slip).unwrap_or(f64::NAN);
     let mut sa: Vec<(String, f64, f64, f64)> = Vec::new(); // (level, wall, slip, error)
     sa.push(("rigid block".into(), ra.wall_time.max(1e-4), ra.brittle.result.residual_displacement, (ra.brittle.result.residual_displacement - ref_slip).abs() / ref_slip.abs()));
-    for r in runs.iter().filter(|r| plain(&r.spec) && r.spec.pga == acc && !is_ref(&r.spec)) {
+    for r in runs.iter().filter(|r| plain(&r.spec) && r.spec.pga == acc && !is_ref(&r.spec) && r.failed.is_none()) {
         sa.push((r.level.clone(), r.wall_time, r.residual_slip, (r.residual_slip - ref_slip).abs() / ref_slip.abs()));
     }
     let pts_sa: Vec<(f64, f64)> = sa.iter().map(|x| (x.1, x.3.max(1e-4))).collect();
@@ -471,10 +500,14 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let mut cheapest = Vec::new();
     for &p in &study.pga {
         let Some(r) = find(&runs, |s| is_ref(s) && s.pga == p) else { continue };
+        if r.failed.is_some() {
+            cheapest.push((p, "none: the reference run failed".to_string(), f64::NAN, f64::NAN));
+            continue;
+        }
         let refv = r.residual_slip;
         let rg = rigid_of(p);
         let mut cands: Vec<(String, f64, f64)> = vec![("rigid block".into(), rg.wall_time, rg.brittle.result.residual_displacement)];
-        for x in runs.iter().filter(|x| plain(&x.spec) && x.spec.pga == p && !is_ref(&x.spec)) {
+        for x in runs.iter().filter(|x| plain(&x.spec) && x.spec.pga == p && !is_ref(&x.spec) && x.failed.is_none()) {
             cands.push((x.level.clone(), x.wall_time, x.residual_slip));
         }
         cands.push((r.level.clone() + " (reference)", r.wall_time, refv));
@@ -485,29 +518,41 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         }
     }
 
-    // ---- trend against the seed
+    // ---- trend against the seed, for each rock model
     let mut trend = Vec::new();
-    let pairs: Vec<(f64, f64, f64)> = study
-        .pga
-        .iter()
-        .filter_map(|&p| {
-            let a = nts_sweep.iter().find(|x| x.0 == p)?.1;
-            let b = ntn_sweep.iter().find(|x| x.0 == p)?.1;
-            Some((p, a, b))
-        })
-        .collect();
-    let sliding: Vec<&(f64, f64, f64)> = pairs.iter().filter(|x| x.1.max(x.2) >= 0.01).collect();
-    let above = sliding.iter().filter(|x| x.1 >= x.2).count();
-    trend.push(format!("NTS ≥ NTN at {above} of the {} PGAs with slip ≥ 1 cm (seed: NTS above NTN at every PGA that slides).", sliding.len()));
-    let diffs: Vec<(f64, f64)> = sliding.iter().map(|x| (x.0, (x.1 - x.2) / x.2.max(1e-12))).collect();
-    let growing = diffs.windows(2).all(|w| w[1].1 >= w[0].1);
-    trend.push(format!(
-        "relative difference (NTS − NTN)/NTN by PGA: {} — {} (seed: the difference grows with PGA).",
-        diffs.iter().map(|(p, d)| format!("{p} g: {}", fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
-        if growing { "grows with PGA" } else { "does not grow monotonically with PGA" }
-    ));
-    if let Some(d) = diffs.iter().find(|x| x.0 == 1.0) {
-        trend.push(format!("at 1.0 g: {} (seed: +26.5 % with the Koyna record, 18.6 cm vs 14.7 cm).", fmt_percent(d.1, 1)));
+    for (label, nts, ntn) in [("elastic rock", &nts_sweep, &ntn_sweep), ("rigid rock", &nts_rigid_rock, &ntn_rigid_rock)] {
+        let pairs: Vec<(f64, f64, f64)> = study
+            .pga
+            .iter()
+            .filter_map(|&p| {
+                let a = nts.iter().find(|x| x.0 == p)?.1;
+                let b = ntn.iter().find(|x| x.0 == p)?.1;
+                Some((p, a, b))
+            })
+            .collect();
+        if pairs.is_empty() {
+            continue;
+        }
+        let sliding: Vec<&(f64, f64, f64)> = pairs.iter().filter(|x| x.1.max(x.2) >= 0.01).collect();
+        let above = sliding.iter().filter(|x| x.1 >= x.2).count();
+        trend.push(format!("{label}: NTS ≥ NTN at {above} of the {} PGAs with slip ≥ 1 cm (seed: NTS above NTN at every PGA that slides).", sliding.len()));
+        let diffs: Vec<(f64, f64)> = sliding.iter().map(|x| (x.0, (x.1 - x.2) / x.2.max(1e-12))).collect();
+        if !diffs.is_empty() {
+            let growing = diffs.windows(2).all(|w| w[1].1 >= w[0].1);
+            trend.push(format!(
+                "{label}: (NTS − NTN)/NTN by PGA: {} — {} (seed: the difference grows with PGA).",
+                diffs.iter().map(|(p, d)| format!("{p} g: {}", fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
+                if growing { "grows with PGA" } else { "does not grow monotonically with PGA" }
+            ));
+        }
+        if let Some(d) = diffs.iter().find(|x| x.0 == 1.0) {
+            trend.push(format!("{label}: at 1.0 g (NTS − NTN)/NTN = {} (seed: +26.5 % with the Koyna record, 18.6 cm vs 14.7 cm).", fmt_percent(d.1, 1)));
+        }
+        let none_below: Vec<f64> = pairs.iter().filter(|x| x.1.max(x.2) < 0.01).map(|x| x.0).collect();
+        trend.push(format!(
+            "{label}: no significant sliding (< 1 cm) at {} (seed: none at 0.5 g and below).",
+            if none_below.is_empty() { "no PGA".to_string() } else { none_below.iter().map(|p| format!("{p} g")).collect::<Vec<_>>().join(", ") }
+        ));
     }
 
     // ---- report.md
@@ -564,9 +609,14 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let _ = writeln!(md, "## Seismic runs\n");
     let mut t = Table::new(["PGA [g]", "level", "P1 ux", "P1 uy", "P1 uz", "slip at P2", "still sliding", "failure mode", "max opening A / B"]);
     for &p in &study.pga {
-        for r in runs.iter().filter(|r| plain(&r.spec) && r.spec.pga == p && r.spec.mesh == sweep && r.spec.layer == 1) {
+        for r in runs.iter().filter(|r| r.spec.e_factor == 1.0 && r.spec.pga == p && r.spec.mesh == sweep && r.spec.layer == 1) {
             let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
-            let _ = t.push_row([m(p), r.level.clone(), m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), m(r.residual_slip), (if r.still_sliding { "yes" } else { "no" }).into(), r.mode.clone(), op]);
+            let level = if r.spec.rigid_rock { format!("{}, rigid rock", r.level) } else { r.level.clone() };
+            let (slip, mode) = match &r.failed {
+                Some(e) => (format!("≥ {} (failed at t = {} s)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))), format!("{}; run stopped: {}", r.mode, e.trim_start_matches("error: "))),
+                None => (m(r.residual_slip), r.mode.clone()),
+            };
+            let _ = t.push_row([m(p), level, m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), mode, op]);
         }
         let rg = rigid_of(p);
         let _ = t.push_row([m(p), "rigid block, cohesion lost".into(), "".into(), "".into(), "".into(), m(rg.brittle.result.residual_displacement), (if rg.brittle.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.brittle.result.n_episodes), "".into()]);
@@ -597,7 +647,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let mut t = Table::new(["variant", "slip at P2", "change"]);
     let base_slip = nts_acc.map(|r| r.residual_slip).unwrap_or(f64::NAN);
     let _ = t.push_row(["E as given".to_string(), m(base_slip), "–".into()]);
-    for r in runs.iter().filter(|r| r.spec.pga == acc && (r.spec.e_factor != 1.0 || r.spec.rigid_rock)) {
+    for r in runs.iter().filter(|r| r.spec.pga == acc && r.spec.method == "nts" && r.spec.mesh == sweep && r.spec.layer == 1 && (r.spec.e_factor != 1.0 || r.spec.rigid_rock)) {
         let name = if r.spec.rigid_rock { "rigid rock (rock nodes fixed; no site response)".to_string() } else { format!("E × {}", r.spec.e_factor) };
         let _ = t.push_row([name, m(r.residual_slip), fmt_percent(r.residual_slip / base_slip - 1.0, 1)]);
     }
@@ -627,7 +677,8 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let mut t = Table::new(["run", "nodes", "elements", "dt [s]", "steps", "wall time [s]", "slip [m]", "lost node-steps A / B"]);
     for r in &runs {
         let lost = r.lost_node_steps.iter().map(|(_, v)| v.to_string()).collect::<Vec<_>>().join(" / ");
-        let _ = t.push_row([r.spec.id.clone(), r.nodes.to_string(), r.elements.to_string(), fmt_sig(r.dt, 3), r.steps.to_string(), m(r.wall_time), m(r.residual_slip), lost]);
+        let slip = if r.failed.is_some() { format!("failed (≥ {})", m(r.max_slip)) } else { m(r.residual_slip) };
+        let _ = t.push_row([r.spec.id.clone(), r.nodes.to_string(), r.elements.to_string(), fmt_sig(r.dt, 3), r.steps.to_string(), m(r.wall_time), slip, lost]);
     }
     md.push_str(&t.to_markdown());
     let report = out.join("report.md");

@@ -168,11 +168,11 @@ fn wedge_seismic_run_slides_only_above_the_critical_acceleration() {
 fn wedge_study_plans_every_level_once_and_the_expensive_runs_first() {
     // The committed study file: 5 PGAs × (NTS, NTN) on coarse and medium, the fine NTS-L2
     // reference at every PGA, and at 1.0 g fine NTS-L1 and NTN, NTS-L2 on coarse and medium,
-    // E × 0.5 and × 2, the rigid rock: 32 runs, no duplicates, fine first.
+    // E × 0.5 and × 2; the medium sweep again on a rigid rock: 41 runs, no duplicates, fine first.
     let study = WedgeStudy::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge_study.json"))).unwrap();
     let runs = plan_runs(&study);
     let mut ids: Vec<&str> = runs.iter().map(|r| r.id.as_str()).collect();
-    assert_eq!(runs.len(), 5 * 2 * 2 + 5 + 2 + 2 + 2 + 1, "{ids:?}");
+    assert_eq!(runs.len(), 5 * 2 * 2 + 5 + 2 + 2 + 2 + 5 * 2, "{ids:?}");
     assert!(runs.iter().take(7).all(|r| r.mesh == "fine"));
     assert_eq!(runs.iter().filter(|r| r.frames).count(), 1);
     ids.sort();
