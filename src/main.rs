@@ -58,8 +58,8 @@ enum Cmd {
     },
     /// Run a scene: gravity equilibrium, dynamic stage, ParaView series, histories, summary.json.
     ///
-    /// Scenes that declare `joints` are refused until contact is integrated in `run`; use
-    /// `jointquake tag` to check their joints.
+    /// Scenes with `joints` run with the dynamic contact force (docs/contact.md); `jointquake tag`
+    /// checks their joints without running.
     Run {
         /// Scene file (JSON, see docs/scenes.md).
         scene: PathBuf,

@@ -292,6 +292,12 @@ impl WedgeStudy {
         self.ssr.mesh.as_deref().unwrap_or(&self.meshes[0].name)
     }
 
+    /// The limit-equilibrium / rigid-block wedge of `scene`: the study's `wedge` geometry with
+    /// the strength of the scene's joints "A" and "B" and the density of `block:wedge`.
+    pub fn wedge_of(&self, scene: &Scene) -> WedgeInput {
+        super::rigid_level::wedge_input_from_scene(&self.wedge, scene, "A", "B", "block:wedge")
+    }
+
     pub fn mesh_level(&self, name: &str) -> &MeshLevel {
         self.meshes.iter().find(|m| m.name == name).expect("validated mesh level name")
     }
@@ -562,7 +568,8 @@ pub fn run_ssr(study: &WedgeStudy, mesh_cache: &Path) -> Result<StudySsr, Error>
     };
     let (nodes, elements) = (mesh.nodes.len(), mesh.cells.iter().filter(|c| c.kind.dim() == 3).count());
     let result = super::ssr::strength_reduction(&mesh, &scene, &ssr_opts)?;
-    let le_fs = analyse_wedge(&study.wedge)?.fs;
-    let le_fs_crest_on_a = analyse_wedge(&WedgeInput { height_def: HeightDef::CrestOnA, ..study.wedge.clone() })?.fs;
+    let le_wedge = study.wedge_of(&scene);
+    let le_fs = analyse_wedge(&le_wedge)?.fs;
+    let le_fs_crest_on_a = analyse_wedge(&WedgeInput { height_def: HeightDef::CrestOnA, ..le_wedge })?.fs;
     Ok(StudySsr { mesh: level, nodes, elements, result, le_fs, le_fs_crest_on_a, wall_time: t0.elapsed().as_secs_f64() })
 }

@@ -263,7 +263,7 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
         rock_peak_accel = Some(pk);
         if rh.t.len() > 2 {
             let dt = rh.t[1] - rh.t[0];
-            if let Ok(r) = rigid_wedge_slip(&study.wedge, &abs, dt, Bond::Brittle, false) {
+            if let Ok(r) = rigid_wedge_slip(&study.wedge_of(&scene), &abs, dt, Bond::Brittle, false) {
                 rigid_on_rock_slip = Some(r.result.residual_displacement);
             }
         }
@@ -319,9 +319,10 @@ fn rigid_at(base: &Scene, study: &WedgeStudy, pga: f64) -> Result<RigidAtPga, Er
     let dt = motions.iter().map(|b| b.record.dt).fold(f64::INFINITY, f64::min);
     let t0 = std::time::Instant::now();
     let a = sample_ground_motion(&motions, dt, scene.time.duration);
-    let brittle = rigid_wedge_slip(&study.wedge, &a, dt, Bond::Brittle, true)?;
+    let wedge = study.wedge_of(&scene);
+    let brittle = rigid_wedge_slip(&wedge, &a, dt, Bond::Brittle, true)?;
     let wall_time = t0.elapsed().as_secs_f64();
-    let kept = rigid_wedge_slip(&study.wedge, &a, dt, Bond::Kept, true)?;
+    let kept = rigid_wedge_slip(&wedge, &a, dt, Bond::Kept, true)?;
     Ok(RigidAtPga { pga, brittle, kept, wall_time })
 }
 
@@ -386,8 +387,9 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         .into());
     }
     let ssr: Option<StudySsr> = std::fs::read_to_string(out.join("ssr.json")).ok().and_then(|t| serde_json::from_str(&t).ok());
-    let le_res = analyse_wedge(&study.wedge)?;
-    let le_crest = analyse_wedge(&WedgeInput { height_def: HeightDef::CrestOnA, ..study.wedge.clone() })?;
+    let le_wedge = study.wedge_of(&base);
+    let le_res = analyse_wedge(&le_wedge)?;
+    let le_crest = analyse_wedge(&WedgeInput { height_def: HeightDef::CrestOnA, ..le_wedge.clone() })?;
     let mut rigid = Vec::new();
     for &pga in &study.pga {
         rigid.push(rigid_at(&base, study, pga)?);
@@ -718,7 +720,7 @@ pub fn write_run_charts(study: &WedgeStudy, scene_path: &Path, run_dir: &Path) -
     if dt.is_finite() {
         let a = sample_ground_motion(&motions, dt, scene.time.duration);
         for (bond, name) in [(Bond::Brittle, "rigid block, cohesion lost at first slide"), (Bond::Kept, "rigid block, cohesion kept")] {
-            let rg = rigid_wedge_slip(&study.wedge, &a, dt, bond, true)?;
+            let rg = rigid_wedge_slip(&study.wedge_of(&scene), &a, dt, bond, true)?;
             if let Some(h) = rg.result.history {
                 c.series.push(Series::line(name, thin(&h.iter().enumerate().map(|(i, &d)| (i as f64 * dt, d)).collect::<Vec<_>>(), 2000)));
             }
