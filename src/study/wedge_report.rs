@@ -410,8 +410,10 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let sweep = study.sweep_mesh().to_string();
     let reference = study.reference_mesh().to_string();
     let rigid_of = |pga: f64| rigid.iter().find(|r| r.pga == pga).expect("rigid level of every PGA");
-    let is_ref = |s: &RunSpec| s.mesh == reference && s.method == "nts" && s.layer == study.reference.layer && s.e_factor == 1.0 && !s.rigid_rock;
-    let plain = |s: &RunSpec| s.e_factor == 1.0 && !s.rigid_rock;
+    let rr = study.main_rigid_rock();
+    let (main_rock, other_rock) = if rr { ("rigid rock", "elastic rock") } else { ("elastic rock", "rigid rock") };
+    let is_ref = |s: &RunSpec| s.mesh == reference && s.method == "nts" && s.layer == study.reference.layer && s.e_factor == 1.0 && s.rigid_rock == rr;
+    let plain = |s: &RunSpec| s.e_factor == 1.0 && s.rigid_rock == rr;
 
     // ---- chart: slip against PGA (finished runs only; a failed run is listed in the tables)
     let pts = |method: &str, mesh: &str, layer: u8, rigid_rock: bool| -> Vec<(f64, f64)> {
@@ -425,20 +427,20 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
             })
             .collect()
     };
-    let nts_sweep = pts("nts", &sweep, 1, false);
-    let ntn_sweep = pts("ntn", &sweep, 1, false);
-    let nts_rigid_rock = pts("nts", &sweep, 1, true);
-    let ntn_rigid_rock = pts("ntn", &sweep, 1, true);
-    let reference_pts = pts("nts", &reference, study.reference.layer, false);
+    let nts_sweep = pts("nts", &sweep, 1, rr);
+    let ntn_sweep = pts("ntn", &sweep, 1, rr);
+    let nts_other = pts("nts", &sweep, 1, !rr);
+    let ntn_other = pts("ntn", &sweep, 1, !rr);
+    let reference_pts = pts("nts", &reference, study.reference.layer, rr);
     let mut c = Chart::new(format!("Residual slip at P2 against PGA ({})", base.name()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), nts_sweep.clone()));
-    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), ntn_sweep.clone()));
+    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {main_rock}"), nts_sweep.clone()));
+    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, {main_rock}"), ntn_sweep.clone()));
     if reference != sweep {
-        c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh (reference)", study.reference.layer), reference_pts.clone()));
+        c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh, {main_rock} (reference)", study.reference.layer), reference_pts.clone()));
     }
-    if !nts_rigid_rock.is_empty() {
-        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, rigid rock"), nts_rigid_rock.clone()));
-        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, rigid rock"), ntn_rigid_rock.clone()));
+    if !nts_other.is_empty() {
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {other_rock}"), nts_other.clone()));
+        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, {other_rock}"), ntn_other.clone()));
     }
     c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", study.pga.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement))));
     c.series.push(Series::line_markers("rigid block, cohesion kept", study.pga.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement))));
@@ -522,7 +524,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
 
     // ---- trend against the seed, for each rock model
     let mut trend = Vec::new();
-    for (label, nts, ntn) in [("elastic rock", &nts_sweep, &ntn_sweep), ("rigid rock", &nts_rigid_rock, &ntn_rigid_rock)] {
+    for (label, nts, ntn) in [(main_rock, &nts_sweep, &ntn_sweep), (other_rock, &nts_other, &ntn_other)] {
         let pairs: Vec<(f64, f64, f64)> = study
             .pga
             .iter()
@@ -574,6 +576,11 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let _ = writeln!(md, "- Joints: A φ = 20°, c = 24 kPa; B φ = 30°, c = 48 kPa (seed table 1). {loss}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).");
     let grav = base.loads.gravity.as_ref().and_then(|g| g.groups.clone()).map(|g| g.join(", ")).unwrap_or_else(|| "all".into());
     let _ = writeln!(md, "- Gravity on: {grav} (the rock is a weightless support, as in limit equilibrium); brought to equilibrium before the record.");
+    let _ = writeln!(
+        md,
+        "- Rock of the main runs: {main_rock}{}. The PGA sweep is repeated with the {other_rock} (tables and the slip-against-PGA chart).",
+        if rr { " (its nodes fixed: the wedge slides on its joints under the base motion itself, as on a stiff massless foundation; the elastic rock box, without absorbing boundaries, rings: see \"The rock's response\")" } else { "" }
+    );
     let recs = base.loads.base.iter().map(|b| format!("`{}` along ({}, {}, {}) × {}", b.record.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(), b.direction[0], b.direction[1], b.direction[2], b.pga.map(|p| format!("PGA {p} g")).or(b.scale.map(|s| format!("scale {s}"))).unwrap_or_else(|| "1".into()))).collect::<Vec<_>>().join("; ");
     let _ = writeln!(md, "- Base motion (base scene): {recs}. Every record is scaled by one factor so that the horizontal PGA takes the study values: by default the committed El Centro 1940 NS record horizontally (y, north) and 2/3 of the same record vertically (z), in phase. The seed used the Koyna record, which is not public.");
     let _ = writeln!(md, "- Damping: {}. Duration {} s per run (record plus free vibration).\n", damping_text(&base), base.time.duration);
@@ -613,7 +620,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     for &p in &study.pga {
         for r in runs.iter().filter(|r| r.spec.e_factor == 1.0 && r.spec.pga == p && r.spec.mesh == sweep && r.spec.layer == 1) {
             let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
-            let level = if r.spec.rigid_rock { format!("{}, rigid rock", r.level) } else { r.level.clone() };
+            let level = format!("{}, {}", r.level, if r.spec.rigid_rock { "rigid rock" } else { "elastic rock" });
             let (slip, mode) = match &r.failed {
                 Some(e) => (format!("≥ {} (failed at t = {} s)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))), format!("{}; run stopped: {}", r.mode, e.trim_start_matches("error: "))),
                 None => (m(r.residual_slip), r.mode.clone()),
@@ -633,10 +640,10 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let _ = writeln!(md);
 
     let _ = writeln!(md, "## The rock's response under the wedge\n");
-    let _ = writeln!(md, "Peak absolute acceleration of the rock node `{}` below the line of intersection (NTS-L1 runs, {sweep} mesh) against the PGA, and the rigid block driven by that computed motion instead of the base record (cohesion lost at the first slide): the part of the FEM slip that the rock's own response explains.\n", study.monitors.rock);
+    let _ = writeln!(md, "Peak absolute acceleration of the rock node `{}` below the line of intersection (NTS-L1 runs on the elastic rock, {sweep} mesh) against the PGA, and the rigid block driven by that computed motion instead of the base record (cohesion lost at the first slide): the part of the elastic-rock slip that the rock's own response explains. The rock box of `geo/wedge.geo` has fixed sides and bottom and no absorbing boundary, so its response is that of a closed box (resonant), not of a slope in a half-space.\n", study.monitors.rock);
     let mut t = Table::new(["PGA [g]", "rock peak x / y / z [g]", "amplification y / PGA", "rigid block on the base record", "rigid block on the rock's motion", "FEM NTS-L1"]);
     for &p in &study.pga {
-        if let Some(r) = find(&runs, |s| plain(s) && s.pga == p && s.method == "nts" && s.mesh == sweep && s.layer == 1) {
+        if let Some(r) = find(&runs, |s| s.e_factor == 1.0 && !s.rigid_rock && s.pga == p && s.method == "nts" && s.mesh == sweep && s.layer == 1) {
             let pk = r.rock_peak_accel.map(|a| format!("{} / {} / {}", m(a[0]), m(a[1]), m(a[2]))).unwrap_or_else(|| "–".into());
             let amp = r.rock_peak_accel.map(|a| m(a[1] / p)).unwrap_or_else(|| "–".into());
             let _ = t.push_row([m(p), pk, amp, m(rigid_of(p).brittle.result.residual_displacement), r.rigid_on_rock_slip.map(m).unwrap_or_else(|| "–".into()), m(r.residual_slip)]);
@@ -645,12 +652,12 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     md.push_str(&t.to_markdown());
     let _ = writeln!(md);
 
-    let _ = writeln!(md, "## Rock stiffness and rigid rock (PGA {acc} g, NTS-L1, {sweep} mesh)\n");
+    let _ = writeln!(md, "## Stiffness and rock model (PGA {acc} g, NTS-L1, {sweep} mesh; the main runs: {main_rock})\n");
     let mut t = Table::new(["variant", "slip at P2", "change"]);
     let base_slip = nts_acc.map(|r| r.residual_slip).unwrap_or(f64::NAN);
     let _ = t.push_row(["E as given".to_string(), m(base_slip), "–".into()]);
-    for r in runs.iter().filter(|r| r.spec.pga == acc && r.spec.method == "nts" && r.spec.mesh == sweep && r.spec.layer == 1 && (r.spec.e_factor != 1.0 || r.spec.rigid_rock)) {
-        let name = if r.spec.rigid_rock { "rigid rock (rock nodes fixed; no site response)".to_string() } else { format!("E × {}", r.spec.e_factor) };
+    for r in runs.iter().filter(|r| r.spec.pga == acc && r.spec.method == "nts" && r.spec.mesh == sweep && r.spec.layer == 1 && (r.spec.e_factor != 1.0 || r.spec.rigid_rock != rr)) {
+        let name = if r.spec.rigid_rock != rr { other_rock.to_string() } else { format!("E × {}", r.spec.e_factor) };
         let _ = t.push_row([name, m(r.residual_slip), fmt_percent(r.residual_slip / base_slip - 1.0, 1)]);
     }
     md.push_str(&t.to_markdown());
