@@ -138,6 +138,11 @@ fn slip_series(w: &PointHistory, r: &PointHistory, e: [f64; 3]) -> Vec<(f64, f64
     (0..n).map(|i| (w.t[i], s(i) - s0)).collect()
 }
 
+/// A history sampled every `dt` from t = 0 as (t, value) points for a chart (thinned).
+fn sampled_history(h: &[f64], dt: f64) -> Vec<(f64, f64)> {
+    thin(&h.iter().enumerate().map(|(i, &d)| (i as f64 * dt, d)).collect::<Vec<_>>(), 2000)
+}
+
 /// Every `stride`-th sample so that at most about `max` remain, always with the last one.
 fn thin<T: Copy>(v: &[T], max: usize) -> Vec<T> {
     let stride = v.len().div_ceil(max.max(1)).max(1);
@@ -438,13 +443,20 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     if reference != sweep {
         c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh, {main_rock} (reference)", study.reference.layer), reference_pts.clone()));
     }
+    let rigid_lost: Vec<(f64, f64)> = study.pga.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement)).collect();
+    let rigid_kept: Vec<(f64, f64)> = study.pga.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement)).collect();
+    c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", rigid_lost.clone()));
+    c.series.push(Series::line_markers("rigid block, cohesion kept", rigid_kept.clone()));
+    charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga"))?.png);
     if !nts_other.is_empty() {
+        // the other rock model on its own chart: its slips can be an order of magnitude apart
+        let mut c = Chart::new(format!("Residual slip at P2 against PGA: {other_rock} and {main_rock}"), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
         c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {other_rock}"), nts_other.clone()));
         c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, {other_rock}"), ntn_other.clone()));
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {main_rock}"), nts_sweep.clone()));
+        c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", rigid_lost));
+        charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga_other_rock"))?.png);
     }
-    c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", study.pga.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement))));
-    c.series.push(Series::line_markers("rigid block, cohesion kept", study.pga.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement))));
-    charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga"))?.png);
 
     // ---- chart: slip history at the accuracy PGA
     let acc = study.accuracy_pga;
@@ -459,7 +471,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     }
     let ra = rigid_of(acc);
     if let Some(h) = &ra.brittle.result.history {
-        c.series.push(Series::line("rigid block (cohesion lost)", thin(&h.iter().enumerate().map(|(i, &d)| (i as f64 * ra.brittle.dt, d)).collect::<Vec<_>>(), 2000)));
+        c.series.push(Series::line("rigid block (cohesion lost)", sampled_history(h, ra.brittle.dt)));
     }
     charts.push(c.write_png_svg(&charts_dir.join("slip_history"))?.png);
 
@@ -622,7 +634,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
             let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
             let level = format!("{}, {}", r.level, if r.spec.rigid_rock { "rigid rock" } else { "elastic rock" });
             let (slip, mode) = match &r.failed {
-                Some(e) => (format!("≥ {} (failed at t = {} s)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))), format!("{}; run stopped: {}", r.mode, e.trim_start_matches("error: "))),
+                Some(_) => (format!("≥ {} (stopped at t = {} s, see below)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))), r.mode.clone()),
                 None => (m(r.residual_slip), r.mode.clone()),
             };
             let _ = t.push_row([m(p), level, m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), mode, op]);
@@ -632,7 +644,18 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         let _ = t.push_row([m(p), "rigid block, cohesion kept".into(), "".into(), "".into(), "".into(), m(rg.kept.result.residual_displacement), (if rg.kept.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.kept.result.n_episodes), "".into()]);
     }
     md.push_str(&t.to_markdown());
-    let _ = writeln!(md, "\n![slip against PGA](charts/slip_vs_pga.svg)\n\n![slip history](charts/slip_history.svg)\n\n![P1 displacement](charts/p1_history.svg)\n");
+    let stopped: Vec<&RunResult> = runs.iter().filter(|r| r.failed.is_some()).collect();
+    if !stopped.is_empty() {
+        let _ = writeln!(md, "\nRuns stopped by their checks (the slip they had reached is a lower bound):\n");
+        for r in stopped {
+            let _ = writeln!(md, "- `{}`: {}", r.spec.id, r.failed.as_deref().unwrap_or("").trim_start_matches("error: "));
+        }
+    }
+    let _ = writeln!(md, "\n![slip against PGA](charts/slip_vs_pga.svg)\n");
+    if !nts_other.is_empty() {
+        let _ = writeln!(md, "![slip against PGA, other rock model](charts/slip_vs_pga_other_rock.svg)\n");
+    }
+    let _ = writeln!(md, "![slip history](charts/slip_history.svg)\n\n![P1 displacement](charts/p1_history.svg)\n");
     let _ = writeln!(md, "### Against the seed's trend\n");
     for s in &trend {
         let _ = writeln!(md, "- {s}");
@@ -676,7 +699,8 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let _ = writeln!(md, "Cheapest level whose residual slip is within {} of the reference (or of 1 cm when the reference is smaller), for each PGA:\n", fmt_percent(study.enough, 0));
     let mut t = Table::new(["PGA [g]", "cheapest sufficient level", "wall time [s]", "slip [m]"]);
     for (p, l, w, s) in &cheapest {
-        let _ = t.push_row([m(*p), l.clone(), m(*w), m(*s)]);
+        let num = |x: f64| if x.is_finite() { m(x) } else { "–".to_string() };
+        let _ = t.push_row([m(*p), l.clone(), num(*w), num(*s)]);
     }
     md.push_str(&t.to_markdown());
     if ssr.is_some() {
@@ -729,7 +753,7 @@ pub fn write_run_charts(study: &WedgeStudy, scene_path: &Path, run_dir: &Path) -
         for (bond, name) in [(Bond::Brittle, "rigid block, cohesion lost at first slide"), (Bond::Kept, "rigid block, cohesion kept")] {
             let rg = rigid_wedge_slip(&study.wedge_of(&scene), &a, dt, bond, true)?;
             if let Some(h) = rg.result.history {
-                c.series.push(Series::line(name, thin(&h.iter().enumerate().map(|(i, &d)| (i as f64 * dt, d)).collect::<Vec<_>>(), 2000)));
+                c.series.push(Series::line(name, sampled_history(&h, dt)));
             }
         }
     }
