@@ -65,6 +65,8 @@ run: venv build
 
 bench: build
 	cargo bench --bench explicit
+	cargo bench --bench tagger
+	cargo bench --bench contact
 
 fixtures: venv
 	GMSH=$(GMSH) scripts/fixtures.sh
