@@ -21,7 +21,8 @@
 //! - `JQ_BENCH_SECONDS`: target wall time of one repeat [s]. Default 1.0: long enough to
 //!   average over a few hundred steps on small meshes, short enough for the 10⁶ cases.
 //! - `JQ_TRIAD_MB`: size of each of the three triad arrays [MB]. Default 512: far above the
-//!   L2 (4 MB) and the last-level cache the VM reports, so the triad measures main memory.
+//!   L2 (2 MB per core) and any last-level cache, so the triad measures main memory (on the
+//!   development VM the triad runs at memory speed from 3 × 64 MB on).
 //! - `JQ_BENCH_DUMP_U=1`: also write the displacement after the determinism check
 //!   (`target/bench/u_<case>.f64`, little-endian f64) to compare two builds.
 use jointquake::dynamics::{loads::Loads, ExplicitSolver, Stage, State};

@@ -248,7 +248,7 @@ impl Schedule {
     /// parallel (they share no node), each chunk's elements in storage order. `warm(nodes)` runs
     /// first on each chunk's distinct nodes (ascending): independent loads that bring the
     /// chunk's nodal data into cache at full memory parallelism, before the element loop's
-    /// gathers, which wait on each other through the scatter (measured: 10–20 % faster at 10⁶
+    /// gathers, which wait on each other through the scatter (measured: about 10 % faster at 10⁶
     /// elements, where the nodal vectors do not fit in cache).
     fn for_each_element(&self, warm: impl Fn(&[u32]) + Sync, body: impl Fn(usize) + Sync) {
         let run = |k: usize| {
