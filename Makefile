@@ -102,6 +102,8 @@ wedge-report: build
 
 bench: build
 	cargo bench --bench explicit
+	cargo bench --bench tagger
+	cargo bench --bench contact
 
 fixtures: venv
 	GMSH=$(GMSH) scripts/fixtures.sh

@@ -3,8 +3,15 @@
 //!
 //! Model: two stacked non-conforming hex8 boxes (lower n × n × 4, upper (n−1) × (n−1) × 4, so the
 //! slave side is the upper box's bottom face), pressed together by a traction on the top. The
-//! same model without the joint gives the contact-free step. Run: `cargo bench --bench contact`
-//! (`JQ_BENCH_N` sets n, default 40 → about 10 % of the nodes are slave nodes).
+//! same model without the joint gives the contact-free step. One thread. Each repeat times
+//! `steps` steps of both models in turn (after 200 warm-up steps each), so that both see the
+//! same load from other users of the machine; best and median of the repeats are reported.
+//! The state after the warm-up and all the repeats is hashed (displacements and every pair's
+//! force, gap, slip), so that two builds can be compared for identical results.
+//! Run: `cargo bench --bench contact`. Knobs (environment):
+//! - `JQ_BENCH_N`: n, default 40 → about 10 % of the nodes are slave nodes;
+//! - `JQ_BENCH_REPEATS`: timed repeats, default 5 (at least 3);
+//! - `JQ_BENCH_STEPS`: steps per repeat, default 400.
 use jointquake::contact::force::ContactSolver;
 use jointquake::dynamics::{loads::Loads, Correction, ExplicitSolver, Stage, State};
 use jointquake::mesh::structured::{add_box, BoxSpec};
@@ -34,55 +41,111 @@ fn build(n: usize, with_joint: bool) -> (Model, jointquake::scene::Scene) {
     (Model::build(mesh, &sc).unwrap(), sc)
 }
 
-fn time_steps(model: &Model, sc: &jointquake::scene::Scene, dt: f64, warm: usize, steps: usize, contact: bool) -> (f64, usize, usize) {
-    let (loads, _) = Loads::build(model, sc).unwrap();
-    let mut solver = ExplicitSolver::new(model, dt, 1.0);
-    let mut state = State::at_rest(model);
-    let mut cs = ContactSolver::new(model, &model.joints);
-    solver.start_energy(model, &mut state);
-    let mut run = |n: usize, state: &mut State| {
-        let mut sweeps = 0;
+/// A model stepped repeatedly: solver, state, contact solver, loads.
+struct Run<'m> {
+    model: &'m Model,
+    loads: Loads,
+    solver: ExplicitSolver,
+    state: State,
+    contact: Option<ContactSolver<'m>>,
+    sweeps: usize,
+}
+
+impl<'m> Run<'m> {
+    fn new(model: &'m Model, sc: &jointquake::scene::Scene, dt: f64, contact: bool) -> Run<'m> {
+        let (loads, _) = Loads::build(model, sc).unwrap();
+        let mut solver = ExplicitSolver::new(model, dt, 1.0);
+        let mut state = State::at_rest(model);
+        solver.start_energy(model, &mut state);
+        let contact = contact.then(|| ContactSolver::new(model, &model.joints));
+        Run { model, loads, solver, state, contact, sweeps: 0 }
+    }
+
+    /// Seconds for `n` steps.
+    fn steps(&mut self, n: usize) -> f64 {
+        let t = Instant::now();
         for _ in 0..n {
-            let info = if contact {
-                solver.step(model, &loads, state, Stage::Dynamic, Some(&mut cs as &mut dyn Correction)).unwrap()
-            } else {
-                solver.step(model, &loads, state, Stage::Dynamic, None).unwrap()
-            };
-            sweeps += info.correction.iterations;
+            let info = match self.contact.as_mut() {
+                Some(cs) => self.solver.step(self.model, &self.loads, &mut self.state, Stage::Dynamic, Some(cs as &mut dyn Correction)),
+                None => self.solver.step(self.model, &self.loads, &mut self.state, Stage::Dynamic, None),
+            }
+            .unwrap();
+            self.sweeps += info.correction.iterations;
         }
-        sweeps
-    };
-    run(warm, &mut state);
-    let t = Instant::now();
-    let sweeps = run(steps, &mut state);
-    let secs = t.elapsed().as_secs_f64();
-    let active = state.contact.joints.first().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).unwrap_or(0);
-    (secs, active, sweeps)
+        t.elapsed().as_secs_f64()
+    }
+
+    fn active_pairs(&self) -> usize {
+        self.state.contact.joints.first().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).unwrap_or(0)
+    }
+
+    /// FNV-1a over the bits of u and of every pair's forces, gap, slip and face.
+    fn state_hash(&self) -> u64 {
+        let mut h = 0xcbf29ce484222325u64;
+        let mut eat = |v: u64| h = (h ^ v).wrapping_mul(0x100000001b3);
+        self.state.u.iter().for_each(|v| eat(v.to_bits()));
+        for j in &self.state.contact.joints {
+            for p in &j.pairs {
+                [p.r_n, p.r_t[0], p.r_t[1], p.gap, p.slip, p.d_t[0], p.d_t[1], p.hist.slip].iter().for_each(|v| eat(v.to_bits()));
+                eat(p.face as u64);
+            }
+        }
+        h
+    }
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 { s[n / 2] } else { 0.5 * (s[n / 2 - 1] + s[n / 2]) }
 }
 
 fn main() {
     let n: usize = std::env::var("JQ_BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(40);
-    let steps = 400;
+    let repeats: usize = std::env::var("JQ_BENCH_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(5usize).max(3);
+    let steps: usize = std::env::var("JQ_BENCH_STEPS").ok().and_then(|v| v.parse().ok()).unwrap_or(400);
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     pool.install(|| {
         let (free, sc_free) = build(n, false);
         let (with, sc_with) = build(n, true);
         let dt = 0.9 * with.stable_dt().min(free.stable_dt());
         let slaves = with.joints[0].tag.n_slave();
-        let (t_free, _, _) = time_steps(&free, &sc_free, dt, 200, steps, false);
-        let (t_with, active, sweeps) = time_steps(&with, &sc_with, dt, 200, steps, true);
-        let per_pair = (t_with - t_free) / (active.max(1) * steps) as f64;
-        let ratio = t_with / t_free;
+        let mut a = Run::new(&free, &sc_free, dt, false);
+        let mut b = Run::new(&with, &sc_with, dt, true);
+        a.steps(200);
+        b.steps(200);
+        b.sweeps = 0;
+        let (mut t_free, mut t_with, mut per_pair, mut ratio) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut active = Vec::new();
+        for _ in 0..repeats {
+            let tf = a.steps(steps);
+            let tw = b.steps(steps);
+            let act = b.active_pairs();
+            t_free.push(1e6 * tf / steps as f64);
+            t_with.push(1e6 * tw / steps as f64);
+            per_pair.push(1e6 * (tw - tf) / (act.max(1) * steps) as f64);
+            ratio.push(tw / tf);
+            active.push(act);
+        }
+        let best = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
         let frac = slaves as f64 / with.n_nodes() as f64;
-        println!("contact benchmark (1 thread): n = {n}, {} nodes, {} hex8, {} slave nodes ({:.1} % of the nodes), {} active pairs", with.n_nodes(), with.n_elements(), slaves, 100.0 * frac, active);
-        println!("  contact-free step   {:9.1} µs", 1e6 * t_free / steps as f64);
-        println!("  step with contact   {:9.1} µs  ({:.2} × the contact-free step; target ≤ 1.5 ×)", 1e6 * t_with / steps as f64, ratio);
-        println!("  per active pair     {:9.3} µs per step, Gauss–Seidel sweeps {:.1} per step (target ≤ 1 µs)", 1e6 * per_pair, sweeps as f64 / steps as f64);
+        let sweeps = b.sweeps as f64 / (repeats * steps) as f64;
+        println!("contact benchmark (1 thread, load average {load}): n = {n}, {} nodes, {} hex8, {} slave nodes ({:.1} % of the nodes), {} active pairs", with.n_nodes(), with.n_elements(), slaves, 100.0 * frac, active[repeats - 1]);
+        println!("  {repeats} repeats of {steps} steps; best / median");
+        println!("  contact-free step   {:9.1} / {:9.1} µs", best(&t_free), median(&t_free));
+        println!("  step with contact   {:9.1} / {:9.1} µs", best(&t_with), median(&t_with));
+        println!("  ratio               {:9.2} / {:9.2}  (target ≤ 1.5)", best(&ratio), median(&ratio));
+        println!("  per active pair     {:9.3} / {:9.3} µs per step (target ≤ 1 µs), Gauss–Seidel sweeps {sweeps:.1} per step", best(&per_pair), median(&per_pair));
+        println!("  state hash after {} steps: {:016x}", 200 + repeats * steps, b.state_hash());
         let json = serde_json::json!({
-            "n": n, "nodes": with.n_nodes(), "elements": with.n_elements(), "slave_nodes": slaves,
-            "slave_fraction": frac, "active_pairs": active, "steps": steps,
-            "step_contact_free_us": 1e6 * t_free / steps as f64, "step_with_contact_us": 1e6 * t_with / steps as f64,
-            "overhead_ratio": ratio, "per_pair_us": 1e6 * per_pair, "sweeps_per_step": sweeps as f64 / steps as f64
+            "load_before": load, "n": n, "nodes": with.n_nodes(), "elements": with.n_elements(), "slave_nodes": slaves,
+            "slave_fraction": frac, "active_pairs": active, "steps_per_repeat": steps, "repeats": repeats,
+            "step_contact_free_us": t_free, "step_with_contact_us": t_with, "overhead_ratio": ratio, "per_pair_us": per_pair,
+            "best": {"step_contact_free_us": best(&t_free), "step_with_contact_us": best(&t_with), "overhead_ratio": best(&ratio), "per_pair_us": best(&per_pair)},
+            "median": {"step_contact_free_us": median(&t_free), "step_with_contact_us": median(&t_with), "overhead_ratio": median(&ratio), "per_pair_us": median(&per_pair)},
+            "sweeps_per_step": sweeps, "state_hash": format!("{:016x}", b.state_hash()),
         });
         let _ = std::fs::create_dir_all("target/bench");
         let _ = std::fs::write("target/bench/contact.json", serde_json::to_string_pretty(&json).unwrap());

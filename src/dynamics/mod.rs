@@ -21,6 +21,59 @@ pub mod record;
 use crate::error::StepError;
 use crate::model::Model;
 use loads::Loads;
+use rayon::prelude::*;
+
+/// Nodes per block of the parallel nodal loops. Default 1024 (3072 entries, 24 kB per vector):
+/// enough work per task to amortise scheduling, small enough to balance two or more threads.
+/// Sums over the nodes (energy increments) are summed within a block in node order and the
+/// block sums in block order, so they do not depend on the number of threads.
+const NODE_BLOCK: usize = 1024;
+
+/// Blocks below which a nodal loop runs on the calling thread. Default 4 (4096 nodes): a
+/// smaller loop takes a few µs, about the cost of handing work to the other threads (and of
+/// waking them when called from outside the thread pool). The result is the same either way.
+const PAR_BLOCKS_MIN: usize = 4;
+
+/// `f` on the blocks of `v` ([`NODE_BLOCK`] nodes, 3 entries each) with the block index,
+/// in parallel for large vectors; the results in block order.
+fn map_blocks_mut<T: Send>(v: &mut [f64], f: impl Fn(usize, &mut [f64]) -> T + Sync + Send) -> Vec<T> {
+    let b = 3 * NODE_BLOCK;
+    if v.len() < PAR_BLOCKS_MIN * b {
+        v.chunks_mut(b).enumerate().map(|(k, x)| f(k, x)).collect()
+    } else {
+        v.par_chunks_mut(b).enumerate().map(|(k, x)| f(k, x)).collect()
+    }
+}
+
+/// Σ over the blocks of entries 0..len of `f(entry range)`, summed in block order (see
+/// [`NODE_BLOCK`]), so the sum does not depend on the number of threads.
+fn sum_blocks<const K: usize>(len: usize, f: impl Fn(std::ops::Range<usize>) -> [f64; K] + Sync) -> [f64; K] {
+    let b = 3 * NODE_BLOCK;
+    let n = len.div_ceil(b);
+    let parts: Vec<[f64; K]> = if n < PAR_BLOCKS_MIN {
+        (0..n).map(|k| f(k * b..((k + 1) * b).min(len))).collect()
+    } else {
+        (0..n).into_par_iter().map(|k| f(k * b..((k + 1) * b).min(len))).collect()
+    };
+    add_parts(&parts)
+}
+
+fn add_parts<const K: usize>(parts: &[[f64; K]]) -> [f64; K] {
+    parts.iter().fold([0.0; K], |mut acc, p| {
+        for j in 0..K {
+            acc[j] += p[j];
+        }
+        acc
+    })
+}
+
+/// `f` on every entry of `v`, in parallel for large vectors.
+fn for_each_entry(v: &mut [f64], f: impl Fn(usize, &mut f64) + Sync + Send) {
+    map_blocks_mut(v, |k, x| {
+        let first = 3 * NODE_BLOCK * k;
+        x.iter_mut().enumerate().for_each(|(i, y)| f(first + i, y))
+    });
+}
 
 /// Running energy account of the dynamic stage [J].
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -119,9 +172,11 @@ pub struct ExplicitSolver {
     pub dt: f64,
     f_int: Vec<f64>,
     f_ext: Vec<f64>,
+    /// u + β v_b (allocated only when the model has β > 0).
     w: Vec<f64>,
     u_next: Vec<f64>,
-    /// K u[n] and K u[n−1] (recovered from K(u + βv_b) when β > 0, see `step`).
+    /// K u[n] and K u[n−1] (recovered from K(u + βv_b) when β > 0, see `step`; allocated only
+    /// when the model has β > 0).
     ku: Vec<f64>,
     ku_prev: Vec<f64>,
     /// After a step: u[n−1] of the step just taken (state.u_prev is u[n], state.u is u[n+1]).
@@ -135,14 +190,15 @@ pub struct ExplicitSolver {
 impl ExplicitSolver {
     pub fn new(model: &Model, dt: f64, energy_tolerance: f64) -> ExplicitSolver {
         let n = 3 * model.n_nodes();
+        let nb = if model.beta > 0.0 { n } else { 0 };
         ExplicitSolver {
             dt,
             f_int: vec![0.0; n],
             f_ext: vec![0.0; n],
-            w: vec![0.0; n],
+            w: vec![0.0; nb],
             u_next: vec![0.0; n],
-            ku: vec![0.0; n],
-            ku_prev: vec![0.0; n],
+            ku: vec![0.0; nb],
+            ku_prev: vec![0.0; nb],
             u_nm1: vec![0.0; n],
             energy_stride: 10,
             energy_tolerance,
@@ -170,69 +226,84 @@ impl ExplicitSolver {
             Stage::Dynamic => (model.alpha, model.beta),
             Stage::Relaxation(a, scale) => {
                 if scale != 1.0 {
-                    self.f_ext.iter_mut().for_each(|f| *f *= scale);
+                    for_each_entry(&mut self.f_ext, |_, f| *f *= scale);
                 }
                 (a, 0.0)
             }
         };
         if beta > 0.0 {
             let c = beta / dt;
-            for ((w, &u), &up) in self.w.iter_mut().zip(&state.u).zip(&state.u_prev) {
-                *w = u + c * (u - up);
-            }
+            for_each_entry(&mut self.w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
             model.internal_forces_into(&self.w, &mut self.f_int);
             // f_int = (1 + c) K u[n] − c K u[n−1] by linearity, so K u[n] follows exactly from
             // K u[n−1] (a recursion that damps its own round-off by c/(1+c) < 1 per step).
-            for i in 0..self.ku.len() {
-                self.ku[i] = (self.f_int[i] + c * self.ku_prev[i]) / (1.0 + c);
-            }
+            let (f_int, ku_prev) = (&self.f_int, &self.ku_prev);
+            for_each_entry(&mut self.ku, |i, k| *k = (f_int[i] + c * ku_prev[i]) / (1.0 + c));
         } else {
             model.internal_forces_into(&state.u, &mut self.f_int);
         }
         let dt2 = dt * dt;
-        for node in 0..model.n_nodes() {
-            let m = model.mass[node];
-            let fx = model.fixed[node];
-            for c in 0..3 {
-                let i = 3 * node + c;
-                if fx & (1 << c) != 0 {
-                    self.u_next[i] = 0.0;
-                    continue;
+        // energy increments over the step, Δu_c = (u[n+1] − u[n−1]) / 2: W_ext, D_α, D_β, and
+        // Σ u[n+1]·0 (non-finite when some u[n+1] is), over the entries r; `u_next` holds the
+        // entries from r.start on
+        let increments = |r: std::ops::Range<usize>, u_next: &[f64]| -> [f64; 4] {
+            let (mut wext, mut damp, mut sdamp, mut finite) = (0.0, 0.0, 0.0, 0.0);
+            let first = r.start;
+            for i in r {
+                let un = u_next[i - first];
+                finite += un * 0.0;
+                if dynamic {
+                    let du = 0.5 * (un - state.u_prev[i]);
+                    wext += du * self.f_ext[i];
+                    if beta > 0.0 {
+                        sdamp += du * (self.f_int[i] - self.ku[i]);
+                    }
+                    if alpha > 0.0 && model.mass_damped[i / 3] {
+                        let vb = (state.u[i] - state.u_prev[i]) / dt;
+                        damp += du * alpha * model.mass[i / 3] * vb;
+                    }
                 }
-                let vb = (state.u[i] - state.u_prev[i]) / dt;
-                let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
-                let a = (self.f_ext[i] - self.f_int[i]) / m - an * vb;
-                self.u_next[i] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * a;
             }
-        }
+            [wext, damp, sdamp, finite]
+        };
+        // the update, one block of nodes per task; with no correction the increments are taken
+        // in the same pass (u[n+1] is final)
+        let fused = correction.is_none();
+        let parts: Vec<[f64; 4]> = map_blocks_mut(&mut self.u_next, |b, un| {
+            let first = b * NODE_BLOCK;
+            for (k, unode) in un.chunks_exact_mut(3).enumerate() {
+                let node = first + k;
+                let m = model.mass[node];
+                let fx = model.fixed[node];
+                for c in 0..3 {
+                    let i = 3 * node + c;
+                    if fx & (1 << c) != 0 {
+                        unode[c] = 0.0;
+                        continue;
+                    }
+                    let vb = (state.u[i] - state.u_prev[i]) / dt;
+                    let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
+                    let a = (self.f_ext[i] - self.f_int[i]) / m - an * vb;
+                    unode[c] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * a;
+                }
+            }
+            if fused { increments(3 * first..3 * first + un.len(), un) } else { [0.0; 4] }
+        });
         let mut info = StepInfo::default();
-        if let Some(c) = correction {
+        let sums = if let Some(c) = correction {
             info.correction = c.correct(model, &mut state.contact, state.t + dt, dt, &state.u_prev, &state.u, &mut self.u_next)?;
-        }
-        // energy increments over the step: Δu_c = (u[n+1] − u[n−1]) / 2
+            sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]))
+        } else {
+            add_parts(&parts)
+        };
         if dynamic {
             let e = &mut state.energy;
-            let mut wext = 0.0;
-            let mut damp = 0.0;
-            let mut sdamp = 0.0;
-            for i in 0..self.u_next.len() {
-                let du = 0.5 * (self.u_next[i] - state.u_prev[i]);
-                wext += du * self.f_ext[i];
-                if beta > 0.0 {
-                    sdamp += du * (self.f_int[i] - self.ku[i]);
-                }
-                if alpha > 0.0 && model.mass_damped[i / 3] {
-                    let vb = (state.u[i] - state.u_prev[i]) / dt;
-                    damp += du * alpha * model.mass[i / 3] * vb;
-                }
-            }
-            e.external_work += wext;
-            e.mass_damping += damp;
-            e.stiffness_damping += sdamp;
+            e.external_work += sums[0];
+            e.mass_damping += sums[1];
+            e.stiffness_damping += sums[2];
             e.contact_work += info.correction.work;
         }
-        // non-finite check (one pass)
-        if !self.u_next.iter().fold(0.0, |s, v| s + v * 0.0).is_finite() {
+        if !sums[3].is_finite() {
             let i = self.u_next.iter().position(|v| !v.is_finite()).unwrap_or(0);
             let node = i / 3;
             return Err(StepError::NonFinite {
@@ -262,9 +333,12 @@ impl ExplicitSolver {
     /// Start the energy account of the dynamic stage from the current state (at rest).
     pub fn start_energy(&mut self, model: &Model, state: &mut State) {
         self.u_nm1.copy_from_slice(&state.u_prev);
-        model.internal_forces_into(&state.u, &mut self.w);
-        self.ku_prev.copy_from_slice(&self.w);
-        let se = 0.5 * state.u.iter().zip(&self.w).map(|(u, f)| u * f).sum::<f64>();
+        // K u into the scratch u_next (overwritten by the next step)
+        model.internal_forces_into(&state.u, &mut self.u_next);
+        if model.beta > 0.0 {
+            self.ku_prev.copy_from_slice(&self.u_next);
+        }
+        let se = 0.5 * state.u.iter().zip(&self.u_next).map(|(u, f)| u * f).sum::<f64>();
         state.energy = Energy { strain: se, initial: se, scale: se.abs(), ..Energy::default() };
     }
 
@@ -279,24 +353,19 @@ impl ExplicitSolver {
     /// bound otherwise (limit: 20 × the energy scale).
     fn check_energy(&mut self, model: &Model, state: &mut State) -> Result<(), StepError> {
         let dt = self.dt;
-        let mut ke = 0.0;
-        for i in 0..state.u.len() {
-            let v = (state.u[i] - state.u_prev[i]) / dt;
-            ke += 0.5 * model.mass[i / 3] * v * v;
-        }
         // K u[n]: the step's internal force when β = 0, else the recovered one (after the swap
         // at the end of the step it sits in ku_prev)
-        if model.beta > 0.0 {
-            self.w.copy_from_slice(&self.ku_prev);
-        } else {
-            self.w.copy_from_slice(&self.f_int);
-        }
-        let mut se_mixed = 0.0;
-        let mut se = 0.0;
-        for i in 0..state.u.len() {
-            se_mixed += 0.5 * state.u[i] * self.w[i];
-            se += 0.5 * state.u_prev[i] * self.w[i];
-        }
+        let ku: &[f64] = if model.beta > 0.0 { &self.ku_prev } else { &self.f_int };
+        let [ke, se_mixed, se] = sum_blocks(state.u.len(), |r| {
+            let (mut ke, mut se_mixed, mut se) = (0.0, 0.0, 0.0);
+            for i in r {
+                let v = (state.u[i] - state.u_prev[i]) / dt;
+                ke += 0.5 * model.mass[i / 3] * v * v;
+                se_mixed += 0.5 * state.u[i] * ku[i];
+                se += 0.5 * state.u_prev[i] * ku[i];
+            }
+            [ke, se_mixed, se]
+        });
         let e = &mut state.energy;
         e.kinetic = ke;
         e.strain = se;

@@ -96,11 +96,32 @@ pub fn add_box(mesh: &mut Mesh, spec: &BoxSpec) {
     let vol_cells: Vec<usize> = (first_cell..mesh.cells.len()).collect();
     let next_tag = |mesh: &Mesh, dim: usize| mesh.groups.iter().filter(|g| g.dim == dim).map(|g| g.tag).max().unwrap_or(0) + 1;
     let t3 = next_tag(mesh, 3);
-    mesh.groups.push(Group { name: format!("block:{}", spec.name), dim: 3, tag: t3, cells: vol_cells.clone() });
-    // boundary faces classified by plane
-    let faces = topology::boundary_faces(mesh, &vol_cells);
+    // boundary faces classified by plane: the faces of the cells of the outer layer of the grid
+    // (only they can have a face on a plane of the box) whose nodes all lie on a plane, in
+    // (cell, local face) order, with the outward node order of `CellKind::faces`: the faces, order
+    // and orientation of `topology::boundary_faces` over the whole block followed by the plane
+    // test below, without a face map of the whole block (test
+    // `boundary_groups_equal_a_search_over_every_cell`).
+    let per_cell = if spec.tets { 6 } else { 1 };
     let tol = 1e-9 * spec.size.iter().fold(0.0f64, |a, &b| a.max(b));
     let planes = [("x0", 0, spec.origin[0]), ("x1", 0, spec.origin[0] + spec.size[0]), ("y0", 1, spec.origin[1]), ("y1", 1, spec.origin[1] + spec.size[1]), ("z0", 2, spec.origin[2]), ("z1", 2, spec.origin[2] + spec.size[2])];
+    let on_plane = |mesh: &Mesh, nodes: &[usize]| planes.iter().any(|&(_, axis, value)| nodes.iter().all(|&n| (mesh.nodes[n][axis] - value).abs() <= tol));
+    let mut faces = Vec::new();
+    for &c in &vol_cells {
+        let g = (c - first_cell) / per_cell;
+        let (i, j, k) = (g % nx, (g / nx) % ny, g / (nx * ny));
+        if !(i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny || k + 1 == nz) {
+            continue;
+        }
+        let cell = &mesh.cells[c];
+        for (local, f) in cell.kind.faces().iter().enumerate() {
+            let nodes: Vec<usize> = f.iter().map(|&a| cell.node(a)).collect();
+            if on_plane(mesh, &nodes) {
+                faces.push(topology::VolumeFace { cell: c, local, nodes });
+            }
+        }
+    }
+    mesh.groups.push(Group { name: format!("block:{}", spec.name), dim: 3, tag: t3, cells: vol_cells });
     for (pname, axis, value) in planes {
         let mut cells = Vec::new();
         for f in &faces {
@@ -137,5 +158,51 @@ mod tests {
         let faces = topology::boundary_faces(&m, &g.cells);
         assert_eq!(faces.len(), 6 * 4 * 2);
         assert_eq!(m.group("b:z1").unwrap().cells.len(), 8);
+    }
+
+    #[test]
+    fn tet_and_hex_volumes_sum_to_the_box_volume() {
+        // Kuhn split: 6 positive tets per cell (volume = corner Jacobian / 6), together the box
+        for tets in [true, false] {
+            let m = box_mesh(&BoxSpec::new("b", [1.5, 0.7, 2.0], [3, 4, 5]).tets(tets).at([1.0, -2.0, 0.5]));
+            let g = m.group("block:b").unwrap();
+            assert_eq!(g.cells.len(), 60 * if tets { 6 } else { 1 });
+            let vol: f64 = if tets {
+                g.cells.iter().map(|&c| m.min_corner_jacobian(c) / 6.0).sum()
+            } else {
+                // cells of a structured box are bricks: volume = product of the edge lengths
+                g.cells
+                    .iter()
+                    .map(|&c| {
+                        let n = m.cells[c].nodes();
+                        (0..3).map(|i| m.nodes[n[6] as usize][i] - m.nodes[n[0] as usize][i]).product::<f64>()
+                    })
+                    .sum()
+            };
+            assert!((vol - 1.5 * 0.7 * 2.0).abs() < 1e-12, "tets {tets}: volume {vol}");
+        }
+    }
+
+    #[test]
+    fn boundary_groups_equal_a_search_over_every_cell() {
+        // the outer-layer search of add_box gives the faces of a search over all cells
+        for tets in [true, false] {
+            let spec = BoxSpec::new("b", [1.0, 2.0, 3.0], [3, 4, 5]).tets(tets).at([-1.0, 0.5, 2.0]);
+            let m = box_mesh(&spec);
+            let all = topology::boundary_faces(&m, &m.group("block:b").unwrap().cells);
+            assert_eq!(all.len(), 2 * (12 + 15 + 20) * if tets { 2 } else { 1 });
+            let from_groups: usize = ["x0", "x1", "y0", "y1", "z0", "z1"].iter().map(|p| m.group(&format!("b:{p}")).unwrap().cells.len()).sum();
+            assert_eq!(from_groups, all.len());
+            // the same faces, nodes (outward order) and order, plane by plane
+            let tol = 1e-9 * 3.0;
+            let planes = [("x0", 0, -1.0), ("x1", 0, 0.0), ("y0", 1, 0.5), ("y1", 1, 2.5), ("z0", 2, 2.0), ("z1", 2, 5.0)];
+            for (p, axis, value) in planes {
+                let expect: Vec<Vec<usize>> =
+                    all.iter().filter(|f| f.nodes.iter().all(|&n| (m.nodes[n][axis] - value).abs() <= tol)).map(|f| f.nodes.clone()).collect();
+                let got: Vec<Vec<usize>> =
+                    m.group(&format!("b:{p}")).unwrap().cells.iter().map(|&c| m.cells[c].nodes().iter().map(|&n| n as usize).collect()).collect();
+                assert_eq!(got, expect, "plane {p}");
+            }
+        }
     }
 }
