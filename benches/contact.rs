@@ -11,7 +11,9 @@
 //! Run: `cargo bench --bench contact`. Knobs (environment):
 //! - `JQ_BENCH_N`: n, default 40 → about 10 % of the nodes are slave nodes;
 //! - `JQ_BENCH_REPEATS`: timed repeats, default 5 (at least 3);
-//! - `JQ_BENCH_STEPS`: steps per repeat, default 400.
+//! - `JQ_BENCH_STEPS`: steps per repeat, default 400;
+//! - `JQ_BENCH_GS_TOL`: Gauss–Seidel tolerance as a fraction of the joint size, default the
+//!   solver's (1e-12).
 use jointquake::contact::force::ContactSolver;
 use jointquake::dynamics::{loads::Loads, Correction, ExplicitSolver, Stage, State};
 use jointquake::mesh::structured::{add_box, BoxSpec};
@@ -57,7 +59,13 @@ impl<'m> Run<'m> {
         let mut solver = ExplicitSolver::new(model, dt, 1.0);
         let mut state = State::at_rest(model);
         solver.start_energy(model, &mut state);
-        let contact = contact.then(|| ContactSolver::new(model, &model.joints));
+        let contact = contact.then(|| {
+            let mut cs = ContactSolver::new(model, &model.joints);
+            if let Some(r) = std::env::var("JQ_BENCH_GS_TOL").ok().and_then(|v| v.parse::<f64>().ok()) {
+                cs.gs_tolerance = r * model.joints[0].tag.size;
+            }
+            cs
+        });
         Run { model, loads, solver, state, contact, sweeps: 0 }
     }
 

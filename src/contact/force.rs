@@ -128,6 +128,14 @@ struct Active {
     hist: PairHistory,
     state: PairState,
     gap: f64,
+    /// The slave node's frame (n, t1, t2), tributary area [m²] and history at t[n].
+    frame: [Vector3<f64>; 3],
+    area: f64,
+    hist0: PairHistory,
+    /// n · (Σ N_I X_I − X_s) on the reference coordinates X [m]: the gap without displacements.
+    gap0: f64,
+    /// Σ N_I u_I − u_s at t[n] [m]: the relative displacement before the step.
+    rel_u: Vector3<f64>,
 }
 
 /// Scratch and settings of the contact correction. Holds no history (that is in `ContactState`).
@@ -242,6 +250,22 @@ fn project_on(
     tol: f64,
 ) -> Option<(usize, super::query::Projection)> {
     let m = &j.tag.master;
+    if let [f] = faces {
+        // one face (the face of the last step): no candidate buffer
+        let face = &m.faces[*f as usize];
+        let nodes = face.nodes();
+        let mut x = [Vector3::zeros(); 4];
+        for (a, &nd) in nodes.iter().enumerate() {
+            x[a] = pos(model, u, nd as usize);
+        }
+        return match select_projection(xs, n, std::iter::once((*f as usize, &x[..nodes.len()])), tol) {
+            Ok(p) => p,
+            Err(_) => {
+                *failures += 1;
+                None
+            }
+        };
+    }
     // candidate sets are small (Layer2 of a structured quad mesh: 16 faces); the stack buffer
     // avoids an allocation per node and step, larger sets fall back to the heap
     let mut stack: [(usize, [Vector3<f64>; 4], usize); 24] = [(0, [Vector3::zeros(); 4], 0); 24];
@@ -304,6 +328,7 @@ fn next_dirty(bits: &[u64], from: usize) -> Option<usize> {
 }
 
 /// Mark every active pair on `node` but `except` for evaluation.
+#[inline(always)]
 fn mark_dirty(bits: &mut [u64], head: &[u32], adj: &[(u32, u32)], node: usize, except: usize) {
     let mut e = head[node];
     while e != u32::MAX {
@@ -495,7 +520,19 @@ impl Correction for ContactSolver<'_> {
                     self.penalty.push((s as u32, masters, nm, weights, rvec));
                     continue;
                 }
+                let mut xbar0 = -Vector3::from(model.mesh.nodes[s]);
+                let mut rel_u = -disp(u, s);
+                for a in 0..nm as usize {
+                    let mi = masters[a] as usize;
+                    xbar0 += Vector3::from(model.mesh.nodes[mi]) * weights[a];
+                    rel_u += disp(u, mi) * weights[a];
+                }
                 self.active.push(Active {
+                    frame: j.frames[i],
+                    area: j.tag.areas[i],
+                    hist0: pr.hist,
+                    gap0: n.dot(&xbar0),
+                    rel_u,
                     joint: ji as u32,
                     pair: i as u32,
                     slave: s as u32,
@@ -565,87 +602,79 @@ impl Correction for ContactSolver<'_> {
         // forces would change by a fraction of that (the fixed point is the same to within the
         // tolerance), and on a coarse, heavy master whose nodes carry dozens of pairs those
         // round-off-sized updates otherwise ripple through every sweep.
-        let mark_tol = 1e-2 * self.gs_tolerance;
+        let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
+        let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
+        let ContactSolver { active, dirty, adj_head, adj, sweep_du, touched, inv_mass, gs_tolerance, gs_max_sweeps, .. } = self;
         let mut sweeps = 0;
-        let mut converged = self.active.is_empty();
-        while !converged && sweeps < self.gs_max_sweeps {
+        let mut converged = active.is_empty();
+        while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
-            let mut next = next_dirty(&self.dirty, 0);
+            let mut next = next_dirty(dirty, 0);
             while let Some(k) = next {
-                self.dirty[k / 64] &= !(1u64 << (k % 64));
-                let a = self.active[k];
-                let j = &self.joints[a.joint as usize];
-                let i = a.pair as usize;
-                let [n, t1, t2] = j.frames[i];
+                dirty[k / 64] &= !(1u64 << (k % 64));
+                let a = &active[k];
+                let [n, t1, t2] = a.frame;
                 let s = a.slave as usize;
-                let hist0 = history.joints[a.joint as usize].pairs[i].hist;
                 // current relative quantities with all forces applied so far
-                let mut xbar = Vector3::zeros();
-                let mut dum = Vector3::zeros();
+                let mut rel = -disp(u_next, s);
                 for b in 0..a.nm as usize {
-                    let mi = a.masters[b] as usize;
-                    xbar += pos(model, u_next, mi) * a.weights[b];
-                    dum += (disp(u_next, mi) - disp(u, mi)) * a.weights[b];
+                    rel += disp(u_next, a.masters[b] as usize) * a.weights[b];
                 }
-                let g_cur = n.dot(&(xbar - pos(model, u_next, s)));
-                let dd = (disp(u_next, s) - disp(u, s)) - dum;
+                let g_cur = a.gap0 + n.dot(&rel);
+                let dd = a.rel_u - rel;
                 // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
                 let g_trial = g_cur - a.dt2w * a.r_n;
                 let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-                let resp = pair_force(&self.law_in_force(j), &hist0, g_trial, dt_trial, a.dt2w, j.tag.areas[i]);
+                let resp = pair_force(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.area);
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
                 if d_rn != 0.0 || d_rt.x != 0.0 || d_rt.y != 0.0 {
                     // the pairs on the nodes this update moves must be evaluated again (a fixed
                     // node never changes a neighbour's force)
                     let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
-                    let im = self.inv_mass[s];
+                    let im = inv_mass[s];
+                    let mut moves = [(0usize, Vector3::zeros()); 5];
+                    let mut nmoves = 0;
                     if im > 0.0 {
-                        let du = dr * (dt2 * im);
-                        if du.norm() > mark_tol {
-                            mark_dirty(&mut self.dirty, &self.adj_head, &self.adj, s, k);
-                        }
-                        for c in 0..3 {
-                            u_next[3 * s + c] += du[c];
-                        }
-                        if self.sweep_du[s] == Vector3::zeros() {
-                            self.touched.push(s as u32);
-                        }
-                        self.sweep_du[s] += du;
+                        moves[0] = (s, dr * (dt2 * im));
+                        nmoves = 1;
                     }
                     for b in 0..a.nm as usize {
                         let mi = a.masters[b] as usize;
-                        let imi = self.inv_mass[mi];
+                        let imi = inv_mass[mi];
                         if imi > 0.0 {
-                            let du = dr * (-dt2 * a.weights[b] * imi);
-                            if du.norm() > mark_tol {
-                                mark_dirty(&mut self.dirty, &self.adj_head, &self.adj, mi, k);
-                            }
-                            for c in 0..3 {
-                                u_next[3 * mi + c] += du[c];
-                            }
-                            if self.sweep_du[mi] == Vector3::zeros() {
-                                self.touched.push(mi as u32);
-                            }
-                            self.sweep_du[mi] += du;
+                            moves[nmoves] = (mi, dr * (-dt2 * a.weights[b] * imi));
+                            nmoves += 1;
                         }
                     }
+                    for &(nd, du) in &moves[..nmoves] {
+                        if du.norm_squared() > mark_tol2 {
+                            mark_dirty(dirty, adj_head, adj, nd, k);
+                        }
+                        for c in 0..3 {
+                            u_next[3 * nd + c] += du[c];
+                        }
+                        if sweep_du[nd] == Vector3::zeros() {
+                            touched.push(nd as u32);
+                        }
+                        sweep_du[nd] += du;
+                    }
                 }
-                let e = &mut self.active[k];
+                let e = &mut active[k];
+                e.gap = g_trial + e.dt2w * resp.r_n;
                 e.r_n = resp.r_n;
                 e.r_t = resp.r_t;
                 e.hist = resp.hist;
                 e.state = resp.state;
-                e.gap = g_trial + a.dt2w * resp.r_n;
-                next = next_dirty(&self.dirty, k + 1);
+                next = next_dirty(dirty, k + 1);
             }
             let mut max_du: f64 = 0.0;
-            for &nd in &self.touched {
-                max_du = max_du.max(self.sweep_du[nd as usize].norm());
-                self.sweep_du[nd as usize] = Vector3::zeros();
+            for &nd in touched.iter() {
+                max_du = max_du.max(sweep_du[nd as usize].norm());
+                sweep_du[nd as usize] = Vector3::zeros();
             }
-            self.touched.clear();
-            converged = max_du <= self.gs_tolerance || self.dirty.iter().all(|&w| w == 0);
+            touched.clear();
+            converged = max_du <= *gs_tolerance || dirty.iter().all(|&w| w == 0);
         }
 
         for &nd in &self.adj_nodes {

@@ -255,13 +255,15 @@ fn el_centro_incline_run(tag: &str, record: &std::path::Path, duration: f64, met
 /// penalty stiffness k per unit area against the slider's E/h = 1e10/0.25 = 4e10 Pa/m.
 /// Measured (docs/validation.md §6): NTS +0.07 %, change +0.004 %; penalty k = 1e11 (2.5 E/h)
 /// +0.08 %, change +0.003 %; k = 1e10 (0.25 E/h) +2.2 %, change −0.03 %; k = 1e9 (0.025 E/h)
-/// +89 % / +123 %, change +17.9 % (the soft, undamped springs let the block rock and hop:
-/// openings of 2–3 cm against 1e-6 m for NTS).
+/// +122 % / +120 % (change −1.3 %; on a build with LU instead of Cramer in the quad projection
+/// +89 % / +123 %, change +17.9 %), Courant 0.7 +92 %, 0.35 +99 % (the soft, undamped springs let
+/// the block rock and hop: openings of 3–5 cm against 1e-6 m for NTS; erratic in dt and in
+/// round-off, so the spread over four steps is asserted, not one halving).
 /// Asserted: NTS and the stiff penalty within 1 % of Newmark and changing by < 0.1 % (more than
 /// 20 × the measured change); the error decreasing with k; the soft penalty > 50 % off Newmark
-/// at both steps and changing by > 5 % under dt halving (measured 17.9 %, and 19.8 % / 71.8 %
-/// for the Courant pairs 0.8 / 0.4 and 0.7 / 0.35: no convergence in dt), i.e. more than 50 ×
-/// the dynamic contact force's change.
+/// at both steps of the halving, and its spread over Courant 0.9, 0.7, 0.45, 0.35 above 5 % of
+/// the Newmark slip (measured 30 %: no convergence in dt) and above 50 × the dynamic contact
+/// force's change.
 #[test]
 fn el_centro_incline_penalty_drifts_under_dt_halving_unless_stiff() {
     let full = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/records/elcentro1940_NS_chopra.txt");
@@ -306,12 +308,23 @@ fn el_centro_incline_penalty_drifts_under_dt_halving_unless_stiff() {
     let (_, _, e_nts, _, c_nts) = rows[0];
     let (_, _, e_stiff, _, c_stiff) = rows[1];
     let (_, _, e_mid, _, _) = rows[2];
-    let (_, _, e_soft, e_soft2, c_soft) = rows[3];
+    let (_, _, e_soft, e_soft2, _) = rows[3];
+    // The soft penalty's answer is erratic in dt (the block rocks and hops on its springs): its
+    // change under one halving depends on round-off (+17.9 % on one build, −1.3 % on another),
+    // so the test takes the spread over four steps, Courant 0.9, 0.7, 0.45 and 0.35.
+    let mut soft = vec![nm.residual_displacement * (1.0 + e_soft), nm.residual_displacement * (1.0 + e_soft2)];
+    for courant in [0.7, 0.35] {
+        let (s, _) = el_centro_incline_run("6s", &rec, duration, "penalty", 1e9, courant);
+        eprintln!("penalty k = 1e9, Courant {courant}: residual slip {s:.5} m ({:+.2} %)", 100.0 * (s - nm.residual_displacement) / nm.residual_displacement);
+        soft.push(s);
+    }
+    let spread = (soft.iter().copied().fold(f64::MIN, f64::max) - soft.iter().copied().fold(f64::MAX, f64::min)) / nm.residual_displacement;
+    eprintln!("soft penalty spread over the four steps: {:.1} % of the Newmark slip", 100.0 * spread);
     assert!(e_nts.abs() < 0.01 && c_nts.abs() < 1e-3, "NTS: error {e_nts:.4}, change {c_nts:.2e}");
     assert!(e_stiff.abs() < 0.01 && c_stiff.abs() < 1e-3, "stiff penalty: error {e_stiff:.4}, change {c_stiff:.2e}");
     assert!(e_stiff.abs() < e_mid.abs() && e_mid.abs() < e_soft.abs(), "error must fall with the penalty stiffness: {e_stiff:.4}, {e_mid:.4}, {e_soft:.4}");
     assert!(e_soft > 0.5 && e_soft2 > 0.5, "soft penalty: errors {e_soft:.3}, {e_soft2:.3}");
-    assert!(c_soft.abs() > 0.05 && c_soft.abs() > 50.0 * c_nts.abs(), "soft penalty dt-halving change {c_soft:.4} vs NTS {c_nts:.2e}");
+    assert!(spread > 0.05 && spread > 50.0 * c_nts.abs(), "soft penalty spread over dt {spread:.4} vs NTS change {c_nts:.2e}");
 }
 
 /// Regression (found by the audit): a pair lost its bond (cohesion) when its trial gap was
