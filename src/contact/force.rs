@@ -149,6 +149,10 @@ pub struct ContactSolver<'m> {
     pub gs_tolerance: f64,
     /// Sweep budget per step. Default 200.
     pub gs_max_sweeps: usize,
+    /// Start each pair that was in contact at the last step from its last force (applied to the
+    /// prediction before the first sweep) instead of zero. Default true: the same fixed point,
+    /// fewer sweeps (12.2 → 10.8 per step on the contact benchmark).
+    pub gs_warm_start: bool,
     /// While true, every joint keeps its bond (cohesion, tensile strength) after a slip or an
     /// opening, as with `keep_cohesion`; a tensile rupture still ends it. Default false. The
     /// pipeline sets it during gravity equilibrium (scene `equilibrium.joint_bonds = "kept"`).
@@ -178,7 +182,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, keep_bonds: false, active: Vec::new(), penalty: Vec::new(), dirty: Vec::new(), adj_head: vec![u32::MAX; model.n_nodes()], adj: Vec::new(), adj_nodes: Vec::new(), sweep_du: vec![Vector3::zeros(); model.n_nodes()], touched: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, active: Vec::new(), penalty: Vec::new(), dirty: Vec::new(), adj_head: vec![u32::MAX; model.n_nodes()], adj: Vec::new(), adj_nodes: Vec::new(), sweep_du: vec![Vector3::zeros(); model.n_nodes()], touched: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -520,6 +524,7 @@ impl Correction for ContactSolver<'_> {
                     self.penalty.push((s as u32, masters, nm, weights, rvec));
                     continue;
                 }
+                let warm = self.gs_warm_start && pr.state != PairState::Open;
                 let mut xbar0 = -Vector3::from(model.mesh.nodes[s]);
                 let mut rel_u = -disp(u, s);
                 for a in 0..nm as usize {
@@ -540,8 +545,9 @@ impl Correction for ContactSolver<'_> {
                     nm,
                     weights,
                     dt2w: dt2 * w,
-                    r_n: 0.0,
-                    r_t: Vector2::zeros(),
+                    // warm start: a pair in contact at the last step starts from its last force
+                    r_n: if warm { pr.r_n } else { 0.0 },
+                    r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
                     hist: pr.hist,
                     state: PairState::Open,
                     gap,
@@ -576,6 +582,26 @@ impl Correction for ContactSolver<'_> {
         }
 
         // ---------------------------------------------------------------- Gauss–Seidel
+        // the warm-start forces act on the prediction before the first sweep
+        for a in &self.active {
+            if a.r_n == 0.0 && a.r_t == Vector2::zeros() {
+                continue;
+            }
+            let [n, t1, t2] = a.frame;
+            let dr = (-n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y) * dt2;
+            let s = a.slave as usize;
+            let im = self.inv_mass[s];
+            for c in 0..3 {
+                u_next[3 * s + c] += dr[c] * im;
+            }
+            for b in 0..a.nm as usize {
+                let mi = a.masters[b] as usize;
+                let f = a.weights[b] * self.inv_mass[mi];
+                for c in 0..3 {
+                    u_next[3 * mi + c] -= dr[c] * f;
+                }
+            }
+        }
         // moving node → active pairs (a linked list per node in `adj`)
         for (k, a) in self.active.iter().enumerate() {
             let nodes = std::iter::once(a.slave).chain(a.masters[..a.nm as usize].iter().copied());
