@@ -69,7 +69,7 @@ enum Cmd {
         /// Mesh cache directory.
         #[arg(long, default_value = "build/mesh")]
         cache: PathBuf,
-        /// Threads (default: all cores). Results are bit-identical whatever the count.
+        /// Threads (default: one below 30 000 elements, else all cores). Results are bit-identical whatever the count.
         #[arg(long)]
         threads: Option<usize>,
         /// No progress bar.
@@ -234,12 +234,12 @@ fn real_main() -> Result<()> {
             if let Some(n) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
             }
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration };
+            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration, threads };
             let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
             say_raw!("{}", summary.to_text());
         }
         Cmd::Tag { scene, out, cache, json } => {
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: None };
+            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: None, threads: None };
             let summary = jointquake::pipeline::tag(&scene, &opts).with_context(|| format!("tagging the joints of scene {}", scene.display()))?;
             if json {
                 say!("{}", serde_json::to_string_pretty(&summary).context("serialising the tag summary")?);

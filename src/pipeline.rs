@@ -26,6 +26,9 @@ pub struct RunOptions {
     pub progress: bool,
     /// Replace the scene's `time.duration` [s]. Default: the scene's.
     pub duration: Option<f64>,
+    /// Threads of the run. Default `None`: [`default_threads`] (one thread below
+    /// [`SERIAL_BELOW_ELEMENTS`] elements, else all of rayon's pool).
+    pub threads: Option<usize>,
 }
 
 /// Peak of a quantity and where it happened.
@@ -137,9 +140,47 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let mesh_path = mesh.source.clone();
     lap("mesh", &mut t);
     let model = Model::build(mesh, &scene)?;
-    let (loads, mut notes) = Loads::build(&model, &scene)?;
+    let (loads, notes) = Loads::build(&model, &scene)?;
     lap("model", &mut t);
+    let threads = opts.threads.unwrap_or_else(|| default_threads(model.n_elements(), rayon::current_num_threads()));
+    if threads == rayon::current_num_threads() {
+        simulate(opts, scene, &model, mesh_path, loads, notes, timings, t, t_all)
+    } else {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| ModelError::Invalid(format!("cannot start {threads} threads: {e}")))?;
+        pool.install(|| simulate(opts, scene, &model, mesh_path, loads, notes, timings, t, t_all))
+    }
+}
 
+/// Below this many elements a run uses one thread unless told otherwise (`RunOptions::threads`,
+/// `jointquake run --threads`). Measured on the 2-core machine (docs/performance.md §1, Two
+/// threads): the wedge's medium mesh (13 941 tet4, two joints) stepped 12 s of El Centro in
+/// 24.1 s on one thread and 28.2 s on two; the fine mesh (26 849 tet4) 46.0 s and 45.6 s. The
+/// contact correction is serial and a model this small does not pay for the threads' start.
+pub const SERIAL_BELOW_ELEMENTS: usize = 30_000;
+
+/// The thread count of a run when none is given: one below [`SERIAL_BELOW_ELEMENTS`], else all
+/// of rayon's (`available`).
+pub fn default_threads(elements: usize, available: usize) -> usize {
+    if elements < SERIAL_BELOW_ELEMENTS { 1 } else { available }
+}
+
+/// The time integration of a built model: equilibrium, dynamic stage, output, summary.
+#[allow(clippy::too_many_arguments)]
+fn simulate(
+    opts: &RunOptions,
+    scene: Scene,
+    model: &Model,
+    mesh_path: PathBuf,
+    loads: Loads,
+    mut notes: Vec<String>,
+    mut timings: Vec<(String, f64)>,
+    mut t: Instant,
+    t_all: Instant,
+) -> Result<RunSummary, Error> {
+    let mut lap = |name: &str, t: &mut Instant| {
+        timings.push((name.to_string(), t.elapsed().as_secs_f64()));
+        *t = Instant::now();
+    };
     let mut contact = if model.joints.is_empty() { None } else { Some(ContactSolver::new(&model, &model.joints)) };
 
     // ---- time step (penalty springs add their stiffness to the highest frequency)
@@ -371,7 +412,7 @@ impl RunSummary {
             self.critical_element,
             self.critical_group
         );
-        let _ = writeln!(s, "  steps           {} over {} s on {} threads", self.steps, self.duration, self.threads);
+        let _ = writeln!(s, "  steps           {} over {} s on {} thread{}", self.steps, self.duration, self.threads, if self.threads == 1 { "" } else { "s" });
         if let Some(eq) = &self.equilibrium {
             let _ = writeln!(s, "  gravity         equilibrium in {} steps, residual {:.2e}{}", eq.steps, eq.residual, if eq.converged { "" } else { " (NOT converged)" });
         }

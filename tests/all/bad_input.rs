@@ -31,7 +31,7 @@ fn column_scene() -> Value {
 /// The error message of `run` on `scene` (which must fail).
 fn run_error(test: &str, scene: &Value) -> String {
     let (p, dir) = write_scene(test, scene);
-    let opts = RunOptions { out_dir: Some(dir.join("out")), mesh_cache: Some(dir.join("mesh")), progress: false, duration: None };
+    let opts = RunOptions { out_dir: Some(dir.join("out")), mesh_cache: Some(dir.join("mesh")), progress: false, duration: None, threads: None };
     match run(&p, &opts) {
         Ok(_) => panic!("{test}: the run should fail"),
         Err(e) => e.to_string(),
