@@ -9,8 +9,9 @@
 //!    counts the node and gives it no force that step. NTN pairs the slave with O (N = [1]).
 //! 2. **Pair force**: trial gap g̃ and tangential increment Δd̃_t with the pair's own force
 //!    removed, then [`super::law::pair_force`] (closes the gap exactly, Mohr-Coulomb in shear).
-//! 3. **Gauss–Seidel**: pairs that share master nodes are coupled; sweeps repeat the pair updates
-//!    until the largest change of gap in a sweep is below `gs_tolerance` (or `gs_max_sweeps`).
+//! 3. **Gauss–Seidel**: pairs that share master nodes are coupled; sweeps repeat the pair updates,
+//!    starting from each pair's force of the last step (`gs_warm_start`), until the largest node
+//!    displacement change in a sweep is below `gs_tolerance` (or `gs_max_sweeps`).
 //!
 //! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 for a node with any fixed component (a fixed
 //! node does not move under contact forces; free components of partly fixed nodes are treated
