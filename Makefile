@@ -62,6 +62,7 @@ test: venv
 	$(BIN) mesh pipelines/column.json
 	GMSH=$(GMSH) cargo test --release --test all -- --ignored gmsh
 	@echo "== meshio cross-check of the column scene"
+	rm -rf target/test-column target/test-demo target/test-impact
 	$(BIN) run pipelines/column.json --out target/test-column --quiet
 	$(PY) scripts/check_vtu.py target/test-column
 	@echo "== the demo's wedge scene (first 2 s) and its charts, cross-checked with meshio"
