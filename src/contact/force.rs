@@ -313,6 +313,23 @@ fn project_on(
     }
 }
 
+/// Add the displacement that a pair force `r` (on the slave node, N; the masters take −N_I r)
+/// makes over one step, dt² r / m, to `u` (free nodes only: `inv_mass` is 0 at fixed ones).
+fn add_pair_force_into(u: &mut [f64], inv_mass: &[f64], dt2: f64, slave: u32, masters: &[u32], weights: &[f64; 4], r: &Vector3<f64>) {
+    let s = slave as usize;
+    let im = inv_mass[s];
+    for c in 0..3 {
+        u[3 * s + c] += dt2 * r[c] * im;
+    }
+    for (a, &m) in masters.iter().enumerate() {
+        let mi = m as usize;
+        let imi = inv_mass[mi];
+        for c in 0..3 {
+            u[3 * mi + c] -= dt2 * weights[a] * r[c] * imi;
+        }
+    }
+}
+
 /// The first set bit of `bits` at or after `from`.
 fn next_dirty(bits: &[u64], from: usize) -> Option<usize> {
     let mut w = from / 64;
@@ -559,18 +576,7 @@ impl Correction for ContactSolver<'_> {
 
         // penalty forces of step n act like external forces on the prediction
         for &(s, masters, nm, weights, rvec) in &self.penalty {
-            let s = s as usize;
-            let im = self.inv_mass[s];
-            for c in 0..3 {
-                u_next[3 * s + c] += dt2 * rvec[c] * im;
-            }
-            for a in 0..nm as usize {
-                let mi = masters[a] as usize;
-                let imi = self.inv_mass[mi];
-                for c in 0..3 {
-                    u_next[3 * mi + c] -= dt2 * weights[a] * rvec[c] * imi;
-                }
-            }
+            add_pair_force_into(u_next, &self.inv_mass, dt2, s, &masters[..nm as usize], &weights, &rvec);
         }
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             let s = s as usize;
@@ -585,22 +591,10 @@ impl Correction for ContactSolver<'_> {
         // ---------------------------------------------------------------- Gauss–Seidel
         // the warm-start forces act on the prediction before the first sweep
         for a in &self.active {
-            if a.r_n == 0.0 && a.r_t == Vector2::zeros() {
-                continue;
-            }
-            let [n, t1, t2] = a.frame;
-            let dr = (-n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y) * dt2;
-            let s = a.slave as usize;
-            let im = self.inv_mass[s];
-            for c in 0..3 {
-                u_next[3 * s + c] += dr[c] * im;
-            }
-            for b in 0..a.nm as usize {
-                let mi = a.masters[b] as usize;
-                let f = a.weights[b] * self.inv_mass[mi];
-                for c in 0..3 {
-                    u_next[3 * mi + c] -= dr[c] * f;
-                }
+            if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
+                let [n, t1, t2] = a.frame;
+                let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
+                add_pair_force_into(u_next, &self.inv_mass, dt2, a.slave, &a.masters[..a.nm as usize], &a.weights, &r);
             }
         }
         // moving node → active pairs (a linked list per node in `adj`)
