@@ -123,12 +123,7 @@ pub fn snap_monitors(model: &Model, scene: &Scene) -> Result<Vec<Monitor>, Error
 /// Run a scene file end to end.
 pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let t_all = Instant::now();
-    let mut timings = Vec::new();
-    let mut lap = |name: &str, t: &mut Instant| {
-        timings.push((name.to_string(), t.elapsed().as_secs_f64()));
-        *t = Instant::now();
-    };
-    let mut t = Instant::now();
+    let mut laps = Laps::start();
     let mut scene = Scene::load(scene_path)?;
     if let Some(d) = opts.duration {
         if !(d.is_finite() && d >= 0.0) {
@@ -138,16 +133,34 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     }
     let mesh = load_mesh(&scene, opts)?;
     let mesh_path = mesh.source.clone();
-    lap("mesh", &mut t);
+    laps.lap("mesh");
     let model = Model::build(mesh, &scene)?;
     let (loads, notes) = Loads::build(&model, &scene)?;
-    lap("model", &mut t);
+    laps.lap("model");
     let threads = opts.threads.unwrap_or_else(|| default_threads(model.n_elements(), rayon::current_num_threads()));
     if threads == rayon::current_num_threads() {
-        simulate(opts, scene, &model, mesh_path, loads, notes, timings, t, t_all)
+        simulate(opts, scene, &model, mesh_path, loads, notes, laps, t_all)
     } else {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| ModelError::Invalid(format!("cannot start {threads} threads: {e}")))?;
-        pool.install(|| simulate(opts, scene, &model, mesh_path, loads, notes, timings, t, t_all))
+        pool.install(|| simulate(opts, scene, &model, mesh_path, loads, notes, laps, t_all))
+    }
+}
+
+/// Wall time of a run's stages [s], in order.
+struct Laps {
+    timings: Vec<(String, f64)>,
+    t: Instant,
+}
+
+impl Laps {
+    fn start() -> Laps {
+        Laps { timings: Vec::new(), t: Instant::now() }
+    }
+
+    /// Close the stage `name` and start the next.
+    fn lap(&mut self, name: &str) {
+        self.timings.push((name.to_string(), self.t.elapsed().as_secs_f64()));
+        self.t = Instant::now();
     }
 }
 
@@ -173,14 +186,9 @@ fn simulate(
     mesh_path: PathBuf,
     loads: Loads,
     mut notes: Vec<String>,
-    mut timings: Vec<(String, f64)>,
-    mut t: Instant,
+    mut laps: Laps,
     t_all: Instant,
 ) -> Result<RunSummary, Error> {
-    let mut lap = |name: &str, t: &mut Instant| {
-        timings.push((name.to_string(), t.elapsed().as_secs_f64()));
-        *t = Instant::now();
-    };
     let mut contact = if model.joints.is_empty() { None } else { Some(ContactSolver::new(&model, &model.joints)) };
 
     // ---- time step (penalty springs add their stiffness to the highest frequency)
@@ -245,7 +253,7 @@ fn simulate(
     } else {
         None
     };
-    lap("equilibrium", &mut t);
+    laps.lap("equilibrium");
 
     // ---- outputs
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
@@ -357,7 +365,7 @@ fn simulate(
         // the last step already wrote its frame (k + 1 == n_steps above)
         jw.flush()?;
     }
-    lap("dynamic", &mut t);
+    laps.lap("dynamic");
 
     let summary = RunSummary {
         scene: scene.name().to_string(),
@@ -387,7 +395,7 @@ fn simulate(
         joints: joint_out.as_ref().map(|j| j.peaks.clone()).unwrap_or_default(),
         out_dir: out_dir.clone(),
         notes,
-        timings,
+        timings: laps.timings,
         wall_time: t_all.elapsed().as_secs_f64(),
     };
     let sp = out_dir.join("summary.json");
