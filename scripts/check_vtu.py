@@ -41,15 +41,21 @@ def ncomp(a):
     return 1 if a.ndim == 1 else a.shape[1]
 
 
-def check_volume(path, m):
-    for name, k in VOLUME_POINT.items():
+def check_point_arrays(path, m, spec, may_be_non_finite=()):
+    """Every array of spec (name -> components) is present, one row per point, finite
+    (except the names in may_be_non_finite)."""
+    for name, k in spec.items():
         if name not in m.point_data:
             fail(f"{path}: point array {name} missing (has {list(m.point_data)})")
         a = np.asarray(m.point_data[name])
         if a.shape[0] != len(m.points) or ncomp(a) != k:
             fail(f"{path}: point array {name} has shape {a.shape}, expected ({len(m.points)}, {k})")
-        if not np.all(np.isfinite(a)):
+        if name not in may_be_non_finite and not np.all(np.isfinite(a)):
             fail(f"{path}: point array {name} has non-finite values")
+
+
+def check_volume(path, m):
+    check_point_arrays(path, m, VOLUME_POINT)
     ncells = sum(len(b.data) for b in m.cells)
     for name, k in VOLUME_CELL.items():
         if name not in m.cell_data:
@@ -65,14 +71,8 @@ def check_volume(path, m):
 
 
 def check_joint(path, m):
-    for name, k in JOINT_POINT.items():
-        if name not in m.point_data:
-            fail(f"{path}: point array {name} missing (has {list(m.point_data)})")
-        a = np.asarray(m.point_data[name])
-        if a.shape[0] != len(m.points) or ncomp(a) != k:
-            fail(f"{path}: point array {name} has shape {a.shape}, expected ({len(m.points)}, {k})")
-        if name != "gap" and not np.all(np.isfinite(a)):
-            fail(f"{path}: point array {name} has non-finite values")
+    # the gap is NaN where a slave node found no master face
+    check_point_arrays(path, m, JOINT_POINT, may_be_non_finite=("gap",))
     state = np.asarray(m.point_data["state"]).ravel()
     if np.any((state < 0) | (state > 3)):
         fail(f"{path}: joint state outside 0..3")
