@@ -35,7 +35,7 @@ pub struct JointPeaks {
     /// Largest penetration (−gap) seen at the end of a step [m].
     pub max_penetration: f64,
     pub max_sweeps: usize,
-    /// Gauss–Seidel tolerance on the largest gap change of a sweep [m] (0 for penalty joints, which
+    /// Gauss–Seidel tolerance on the largest node displacement change of a sweep [m] (0 for penalty joints, which
     /// are not iterated), and the steps that did not reach it within the sweep budget.
     pub gs_tolerance: f64,
     pub unconverged_steps: u64,
