@@ -10,8 +10,10 @@
 //! 2. **Pair force**: trial gap g̃ and tangential increment Δd̃_t with the pair's own force
 //!    removed, then [`super::law::pair_force`] (closes the gap exactly, Mohr-Coulomb in shear).
 //! 3. **Gauss–Seidel**: pairs that share master nodes are coupled; sweeps repeat the pair updates,
-//!    starting from each pair's force of the last step (`gs_warm_start`), until the largest node
-//!    displacement change in a sweep is below `gs_tolerance` (or `gs_max_sweeps`).
+//!    starting from each pair's force of the last step (`gs_warm_start`), in colour order (pairs
+//!    of one colour share no node, `gs_colored`), until the largest node displacement change in
+//!    a sweep is below `gs_tolerance` (or `gs_max_sweeps`). A sweep skips the pairs none of
+//!    whose nodes moved since their last evaluation (exact: they would give the same force).
 //!
 //! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 for a node with any fixed component (a fixed
 //! node does not move under contact forces; free components of partly fixed nodes are treated
@@ -24,7 +26,7 @@
 
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force, penalty_force, JointLaw, PairHistory, PairState};
-use super::query::{select_projection, Location, INSIDE_TOL_DEFAULT};
+use super::query::{project_along_on_quad_from, project_along_on_tri, select_projection, Location, INSIDE_TOL_DEFAULT};
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
 use crate::model::Model;
@@ -37,8 +39,9 @@ pub struct PairRecord {
     pub state: PairState,
     /// Master-local node around which candidate faces are taken (starts at the tagger's O).
     pub center: u32,
-    /// Master face of the last projection (−1: none).
+    /// Master face of the last projection (−1: none) and the local coordinates on it.
     pub face: i32,
+    pub xi: [f64; 2],
     /// Gap at the end of the last step [m] (NaN when the node found no face).
     pub gap: f64,
     /// Normal (compressive, N) and tangential (N, in t1/t2) force of the last step.
@@ -99,6 +102,7 @@ impl ContactState {
                             state: PairState::Open,
                             center: j.tag.nearest[i],
                             face: -1,
+                            xi: [0.0; 2],
                             gap: f64::NAN,
                             r_n: 0.0,
                             r_t: [0.0; 2],
@@ -113,15 +117,31 @@ impl ContactState {
     }
 }
 
+/// Gauss–Seidel scratch of one node, kept together so that a pair update reads one place per
+/// node.
+#[derive(Clone, Copy, Debug, Default)]
+struct NodeScratch {
+    /// Displacement change [m] applied during the current sweep (valid when `sweep` equals the
+    /// solver's `sweep_clock`).
+    du: Vector3<f64>,
+    sweep: u32,
+    /// The work list, as clocks: each pair update ticks the clock; `moved_at` is the tick at
+    /// which the node was last moved (by more than the marking tolerance), and a pair's
+    /// `evaluated_at` the tick of its last evaluation. A sweep evaluates only the pairs one of
+    /// whose nodes moved since their own last evaluation (first sweep: all): a pair whose nodes
+    /// did not change would give the same force, so skipping it is exact. Pairs later in the
+    /// order are taken in the same sweep, earlier ones in the next. (Reading five clocks per
+    /// pair is cheaper than marking every pair on a moved node, which an earlier bit set with
+    /// per-node lists did.)
+    moved_at: u32,
+}
+
 /// One active pair of the current step (scratch).
 #[derive(Clone, Copy, Debug)]
 struct Active {
     joint: u32,
     pair: u32,
-    slave: u32,
-    masters: [u32; 4],
     nm: u8,
-    weights: [f64; 4],
     dt2w: f64,
     /// Applied force components (r_n compressive, r_t) of the current Gauss–Seidel iterate.
     r_n: f64,
@@ -137,6 +157,16 @@ struct Active {
     gap0: f64,
     /// Σ N_I u_I − u_s at t[n] [m]: the relative displacement before the step.
     rel_u: Vector3<f64>,
+    /// The pair's nodes, slave first then its `nm` masters, their coefficients in
+    /// Σ N_I u_I − u_s (−1 for the slave, N_I for the masters), and the displacement a unit
+    /// pair force gives each over one step (dt²/m_s for the slave, −dt² N_I/m_I for the masters,
+    /// 0 at a fixed node; `moving` bit b set when node b is free, i.e. 1/m > 0). Always five
+    /// entries, so that the Gauss–Seidel update has no loop bounds to test: entries past the
+    /// masters repeat the slave with coefficient and mobility 0.
+    nodes: [u32; 5],
+    coef: [f64; 5],
+    mob: [f64; 5],
+    moving: u8,
 }
 
 /// Scratch and settings of the contact correction. Holds no history (that is in `ContactState`).
@@ -154,26 +184,29 @@ pub struct ContactSolver<'m> {
     /// prediction before the first sweep) instead of zero. Default true: the same fixed point,
     /// fewer sweeps (12.2 → 10.8 per step on the contact benchmark).
     pub gs_warm_start: bool,
+    /// Sweep the pairs in colour order ([`Self::order_by_color`]) instead of the order of the
+    /// slave nodes. Default true: the same fixed point in fewer sweeps (10.8 → 8.6 per step on
+    /// the contact benchmark).
+    pub gs_colored: bool,
     /// While true, every joint keeps its bond (cohesion, tensile strength) after a slip or an
     /// opening, as with `keep_cohesion`; a tensile rupture still ends it. Default false. The
     /// pipeline sets it during gravity equilibrium (scene `equilibrium.joint_bonds = "kept"`).
     pub keep_bonds: bool,
     active: Vec<Active>,
+    /// Scratch of [`Self::order_by_color`]: per node the colours of its pairs, per pair its colour.
+    color_mask: Vec<u64>,
+    colors: Vec<u8>,
+    order: Vec<u32>,
+    sorted: Vec<Active>,
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
     inv_mass: Vec<f64>,
     cand: Vec<u32>,
-    /// Gauss–Seidel work list: bit k set = active pair k must be evaluated (first sweep: all;
-    /// then only the pairs one of whose moving nodes another pair's update moved since their own
-    /// last evaluation: a pair whose nodes did not change would give the same force, so skipping
-    /// it is exact). Pairs of higher index are taken in the same sweep, lower ones in the next.
-    dirty: Vec<u64>,
-    /// Per moving node: head of its list of (pair) entries in `adj`, `u32::MAX` = none.
-    adj_head: Vec<u32>,
-    /// Entries (active pair index, next entry of the same node).
-    adj: Vec<(u32, u32)>,
-    adj_nodes: Vec<u32>,
-    /// Per node: displacement change [m] applied during the current sweep, and the nodes touched.
-    sweep_du: Vec<Vector3<f64>>,
+    /// Per node, the Gauss–Seidel scratch in one cache line's quarter (see [`NodeScratch`]).
+    node: Vec<NodeScratch>,
+    /// Per active pair: the tick of its last evaluation (see [`NodeScratch::moved_at`]).
+    evaluated_at: Vec<u32>,
+    /// Count of sweeps so far (all steps; `NodeScratch::sweep` compares with it).
+    sweep_clock: u32,
     touched: Vec<u32>,
 }
 
@@ -183,7 +216,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, active: Vec::new(), penalty: Vec::new(), dirty: Vec::new(), adj_head: vec![u32::MAX; model.n_nodes()], adj: Vec::new(), adj_nodes: Vec::new(), sweep_du: vec![Vector3::zeros(); model.n_nodes()], touched: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, gs_colored: true, color_mask: vec![0; model.n_nodes()], colors: Vec::new(), order: Vec::new(), sorted: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), sweep_clock: 0, touched: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -209,6 +242,52 @@ impl<'m> ContactSolver<'m> {
     /// The joint's law as it applies now: with [`Self::keep_bonds`] its bond is kept.
     fn law_in_force(&self, j: &ContactJoint) -> JointLaw {
         if self.keep_bonds { JointLaw { keep_cohesion: true, ..j.law } } else { j.law }
+    }
+
+    /// Reorder the active pairs by colour: a greedy colouring in which no two pairs of one
+    /// colour share a moving node (pairs in their order of the search, each the lowest colour
+    /// none of its nodes has yet; 4 colours on a structured quad master), then a stable sort by
+    /// colour. The pairs of one colour are uncoupled, so one pass over them solves them
+    /// exactly together, and the sweeps converge faster than in the order of the slave nodes
+    /// (10.8 → 8.6 sweeps per step on the contact benchmark, and the same 18 on the wedge).
+    /// Deterministic: the colours follow from the active pairs alone.
+    fn order_by_color(&mut self) {
+        let mut count = [0usize; 64];
+        self.colors.clear();
+        for a in &self.active {
+            let mut used = 0u64;
+            for b in 0..a.nm as usize + 1 {
+                if a.moving & (1 << b) != 0 {
+                    used |= self.color_mask[a.nodes[b] as usize];
+                }
+            }
+            let c = (!used).trailing_zeros().min(63);
+            for b in 0..a.nm as usize + 1 {
+                if a.moving & (1 << b) != 0 {
+                    self.color_mask[a.nodes[b] as usize] |= 1u64 << c;
+                }
+            }
+            self.colors.push(c as u8);
+            count[c as usize] += 1;
+        }
+        for a in &self.active {
+            for &nd in &a.nodes[..a.nm as usize + 1] {
+                self.color_mask[nd as usize] = 0;
+            }
+        }
+        let mut start = [0usize; 64];
+        for c in 1..64 {
+            start[c] = start[c - 1] + count[c - 1];
+        }
+        self.order.clear();
+        self.order.resize(self.active.len(), 0);
+        for (k, &c) in self.colors.iter().enumerate() {
+            self.order[start[c as usize]] = k as u32;
+            start[c as usize] += 1;
+        }
+        self.sorted.clear();
+        self.sorted.extend(self.order.iter().map(|&k| self.active[k as usize]));
+        std::mem::swap(&mut self.active, &mut self.sorted);
     }
 
     fn candidates_into(&mut self, j: &ContactJoint, center: u32, layer: u8) {
@@ -253,19 +332,28 @@ fn project_on(
     u: &[f64],
     failures: &mut u64,
     tol: f64,
+    xi0: [f64; 2],
 ) -> Option<(usize, super::query::Projection)> {
     let m = &j.tag.master;
     if let [f] = faces {
-        // one face (the face of the last step): no candidate buffer
+        // one face (the face of the last step): no candidate buffer, no selection, and a quad's
+        // Newton starts from the node's local coordinates of the last step (`xi0`)
         let face = &m.faces[*f as usize];
         let nodes = face.nodes();
         let mut x = [Vector3::zeros(); 4];
         for (a, &nd) in nodes.iter().enumerate() {
             x[a] = pos(model, u, nd as usize);
         }
-        return match select_projection(xs, n, std::iter::once((*f as usize, &x[..nodes.len()])), tol) {
-            Ok(p) => p,
-            Err(_) => {
+        return match nodes.len() {
+            3 => project_along_on_tri(xs, n, [&x[0], &x[1], &x[2]], tol).map(|p| (*f as usize, p)),
+            4 => match project_along_on_quad_from(xs, n, [&x[0], &x[1], &x[2], &x[3]], tol, xi0) {
+                Ok(p) => p.map(|p| (*f as usize, p)),
+                Err(_) => {
+                    *failures += 1;
+                    None
+                }
+            },
+            _ => {
                 *failures += 1;
                 None
             }
@@ -330,36 +418,17 @@ fn add_pair_force_into(u: &mut [f64], inv_mass: &[f64], dt2: f64, slave: u32, ma
     }
 }
 
-/// The first set bit of `bits` at or after `from`.
-fn next_dirty(bits: &[u64], from: usize) -> Option<usize> {
-    let mut w = from / 64;
-    if w >= bits.len() {
-        return None;
-    }
-    let mut word = bits[w] & (u64::MAX << (from % 64));
-    loop {
-        if word != 0 {
-            return Some(w * 64 + word.trailing_zeros() as usize);
-        }
-        w += 1;
-        if w >= bits.len() {
-            return None;
-        }
-        word = bits[w];
-    }
+/// Whether active pair `a`, last evaluated at tick `since`, has a node moved after it.
+#[inline(always)]
+fn moved_since(node: &[NodeScratch], a: &Active, since: u32) -> bool {
+    a.nodes.iter().fold(0, |m, &nd| m.max(node[nd as usize].moved_at)) > since
 }
 
-/// Mark every active pair on `node` but `except` for evaluation.
 #[inline(always)]
-fn mark_dirty(bits: &mut [u64], head: &[u32], adj: &[(u32, u32)], node: usize, except: usize) {
-    let mut e = head[node];
-    while e != u32::MAX {
-        let (k, next) = adj[e as usize];
-        if k as usize != except {
-            bits[k as usize / 64] |= 1u64 << (k % 64);
-        }
-        e = next;
-    }
+fn node3(u: &[f64], nd: u32) -> Vector3<f64> {
+    let i = 3 * nd as usize;
+    let v = &u[i..i + 3];
+    Vector3::new(v[0], v[1], v[2])
 }
 
 impl Correction for ContactSolver<'_> {
@@ -402,12 +471,12 @@ impl Correction for ContactSolver<'_> {
                         let mut found = None;
                         if pr.face >= 0 {
                             let f = pr.face as usize;
-                            if let Some((ff, p)) = project_on(model, j, &[f as u32], &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT)
+                            if let Some((ff, p)) = project_on(model, j, &[f as u32], &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
                                 && p.location == Location::Inside
                             {
                                 let x0 = pos(model, conf, j.tag.master.faces[f].nodes()[0] as usize);
                                 let x1 = pos(model, conf, j.tag.master.faces[f].nodes()[1] as usize);
-                                if p.t.abs() <= 0.5 * (x1 - x0).norm() {
+                                if p.t * p.t <= 0.25 * (x1 - x0).norm_squared() {
                                     found = Some((ff, p));
                                 }
                             }
@@ -415,13 +484,13 @@ impl Correction for ContactSolver<'_> {
                         if found.is_none() {
                             self.candidates_into(j, pr.center, j.layer);
                             let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
+                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
                             self.cand = cand;
                         }
                         if found.is_none() {
                             // a node just off the master's free edge (see `edge_tolerance`)
                             let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance);
+                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance, [0.0, 0.0]);
                             self.cand = cand;
                             if found.is_some() {
                                 rec.events.perimeter_kept += 1;
@@ -431,7 +500,7 @@ impl Correction for ContactSolver<'_> {
                             if j.layer < 2 {
                                 self.candidates_into(j, pr.center, 2);
                                 let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
                                 self.cand = cand;
                                 if found.is_some() {
                                     rec.events.widened_layer2 += 1;
@@ -461,7 +530,7 @@ impl Correction for ContactSolver<'_> {
                                 rec.pairs[i].center = c as u32;
                                 self.candidates_into(j, c as u32, 2);
                                 let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
                                 self.cand = cand;
                             }
                         }
@@ -486,6 +555,7 @@ impl Correction for ContactSolver<'_> {
                                 for (a, &nd) in nodes.iter().enumerate() {
                                     ms[a] = nd;
                                 }
+                                rec.pairs[i].xi = p.xi;
                                 (ms, nodes.len() as u8, p.weights, f as i32)
                             }
                             None => {
@@ -508,16 +578,16 @@ impl Correction for ContactSolver<'_> {
                 if w == 0.0 {
                     continue;
                 }
-                // current gap and relative displacement on the chosen configuration
-                let mut xbar = Vector3::zeros();
-                let mut um_n = Vector3::zeros();
-                for a in 0..nm as usize {
-                    let mi = masters[a] as usize;
-                    xbar += pos(model, conf, mi) * weights[a];
-                    um_n += disp(u, mi) * weights[a];
-                }
-                let gap = n.dot(&(xbar - xs));
                 if let Method::Penalty { kn, kt } = j.method {
+                    // current gap and relative displacement on the configuration at t[n]
+                    let mut xbar = Vector3::zeros();
+                    let mut um_n = Vector3::zeros();
+                    for a in 0..nm as usize {
+                        let mi = masters[a] as usize;
+                        xbar += pos(model, conf, mi) * weights[a];
+                        um_n += disp(u, mi) * weights[a];
+                    }
+                    let gap = n.dot(&(xbar - xs));
                     // explicit penalty at t[n]: tangential increment over the last step
                     let mut um_p = Vector3::zeros();
                     for a in 0..nm as usize {
@@ -550,7 +620,29 @@ impl Correction for ContactSolver<'_> {
                     xbar0 += Vector3::from(model.mesh.nodes[mi]) * weights[a];
                     rel_u += disp(u, mi) * weights[a];
                 }
+                let mut nodes5 = [s as u32; 5];
+                let mut coef = [-1.0, 0.0, 0.0, 0.0, 0.0];
+                let mut mob = [0.0; 5];
+                let mut moving = 0u8;
+                if self.inv_mass[s] > 0.0 {
+                    mob[0] = dt2 * self.inv_mass[s];
+                    moving |= 1;
+                }
+                for b in 0..nm as usize {
+                    let mi = masters[b] as usize;
+                    nodes5[b + 1] = masters[b];
+                    coef[b + 1] = weights[b];
+                    let imi = self.inv_mass[mi];
+                    if imi > 0.0 {
+                        mob[b + 1] = -dt2 * weights[b] * imi;
+                        moving |= 1 << (b + 1);
+                    }
+                }
                 self.active.push(Active {
+                    nodes: nodes5,
+                    coef,
+                    mob,
+                    moving,
                     frame: j.frames[i],
                     area: j.tag.areas[i],
                     hist0: pr.hist,
@@ -558,17 +650,15 @@ impl Correction for ContactSolver<'_> {
                     rel_u,
                     joint: ji as u32,
                     pair: i as u32,
-                    slave: s as u32,
-                    masters,
                     nm,
-                    weights,
                     dt2w: dt2 * w,
                     // warm start: a pair in contact at the last step starts from its last force
                     r_n: if warm { pr.r_n } else { 0.0 },
                     r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
                     hist: pr.hist,
                     state: PairState::Open,
-                    gap,
+                    // set by the first sweep, which evaluates every pair
+                    gap: f64::NAN,
                 });
                 rec.pairs[i].face = face;
             }
@@ -594,52 +684,55 @@ impl Correction for ContactSolver<'_> {
             if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
                 let [n, t1, t2] = a.frame;
                 let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                add_pair_force_into(u_next, &self.inv_mass, dt2, a.slave, &a.masters[..a.nm as usize], &a.weights, &r);
+                let weights = [a.coef[1], a.coef[2], a.coef[3], a.coef[4]];
+                add_pair_force_into(u_next, &self.inv_mass, dt2, a.nodes[0], &a.nodes[1..a.nm as usize + 1], &weights, &r);
             }
         }
-        // moving node → active pairs (a linked list per node in `adj`)
-        for (k, a) in self.active.iter().enumerate() {
-            let nodes = std::iter::once(a.slave).chain(a.masters[..a.nm as usize].iter().copied());
-            for nd in nodes {
+        if self.gs_colored {
+            self.order_by_color();
+        }
+        // every moving node of an active pair counts as moved at tick 1, every pair as last
+        // evaluated at tick 0: the first sweep evaluates all
+        for a in &self.active {
+            for &nd in &a.nodes[..a.nm as usize + 1] {
                 if self.inv_mass[nd as usize] > 0.0 {
-                    let head = &mut self.adj_head[nd as usize];
-                    if *head == u32::MAX {
-                        self.adj_nodes.push(nd);
-                    }
-                    self.adj.push((k as u32, *head));
-                    *head = (self.adj.len() - 1) as u32;
+                    self.node[nd as usize].moved_at = 1;
                 }
             }
         }
-        let words = self.active.len().div_ceil(64);
-        self.dirty.clear();
-        self.dirty.resize(words, u64::MAX);
-        if let Some(last) = self.dirty.last_mut()
-            && self.active.len() % 64 != 0
-        {
-            *last = (1u64 << (self.active.len() % 64)) - 1;
-        }
+        self.evaluated_at.clear();
+        self.evaluated_at.resize(self.active.len(), 0);
+        let mut clock = 1u32;
         // A node moved by less than 1 % of the tolerance does not call its pairs back: their
         // forces would change by a fraction of that (the fixed point is the same to within the
         // tolerance), and on a coarse, heavy master whose nodes carry dozens of pairs those
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, dirty, adj_head, adj, sweep_du, touched, inv_mass, gs_tolerance, gs_max_sweeps, .. } = self;
+        let ContactSolver { active, node, evaluated_at, sweep_clock, touched, gs_tolerance, gs_max_sweeps, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
-            let mut next = next_dirty(dirty, 0);
-            while let Some(k) = next {
-                dirty[k / 64] &= !(1u64 << (k % 64));
+            if *sweep_clock == u32::MAX {
+                node.iter_mut().for_each(|ns| ns.sweep = 0);
+                *sweep_clock = 0;
+            }
+            *sweep_clock += 1;
+            let sweep_clock = *sweep_clock;
+            for k in 0..active.len() {
                 let a = &active[k];
+                if !moved_since(node, a, evaluated_at[k]) {
+                    continue;
+                }
+                clock += 1;
+                evaluated_at[k] = clock;
                 let [n, t1, t2] = a.frame;
-                let s = a.slave as usize;
-                // current relative quantities with all forces applied so far
-                let mut rel = -disp(u_next, s);
-                for b in 0..a.nm as usize {
-                    rel += disp(u_next, a.masters[b] as usize) * a.weights[b];
+                // current relative quantities with all forces applied so far (five nodes
+                // always: unused entries repeat the slave with coefficient and mobility 0)
+                let mut rel = Vector3::zeros();
+                for b in 0..5 {
+                    rel += node3(u_next, a.nodes[b]) * a.coef[b];
                 }
                 let g_cur = a.gap0 + n.dot(&rel);
                 let dd = a.rel_u - rel;
@@ -653,32 +746,25 @@ impl Correction for ContactSolver<'_> {
                     // the pairs on the nodes this update moves must be evaluated again (a fixed
                     // node never changes a neighbour's force)
                     let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
-                    let im = inv_mass[s];
-                    let mut moves = [(0usize, Vector3::zeros()); 5];
-                    let mut nmoves = 0;
-                    if im > 0.0 {
-                        moves[0] = (s, dr * (dt2 * im));
-                        nmoves = 1;
-                    }
-                    for b in 0..a.nm as usize {
-                        let mi = a.masters[b] as usize;
-                        let imi = inv_mass[mi];
-                        if imi > 0.0 {
-                            moves[nmoves] = (mi, dr * (-dt2 * a.weights[b] * imi));
-                            nmoves += 1;
-                        }
-                    }
-                    for &(nd, du) in &moves[..nmoves] {
+                    for b in 0..5 {
+                        // a fixed node or an unused entry has mobility 0: it does not move
+                        let nd = a.nodes[b] as usize;
+                        let du = dr * a.mob[b];
                         if du.norm_squared() > mark_tol2 {
-                            mark_dirty(dirty, adj_head, adj, nd, k);
+                            node[nd].moved_at = clock;
                         }
-                        for c in 0..3 {
-                            u_next[3 * nd + c] += du[c];
-                        }
-                        if sweep_du[nd] == Vector3::zeros() {
+                        let v = &mut u_next[3 * nd..3 * nd + 3];
+                        v[0] += du[0];
+                        v[1] += du[1];
+                        v[2] += du[2];
+                        let ns = &mut node[nd];
+                        if ns.sweep != sweep_clock {
+                            ns.sweep = sweep_clock;
+                            ns.du = du;
                             touched.push(nd as u32);
+                        } else {
+                            ns.du += du;
                         }
-                        sweep_du[nd] += du;
                     }
                 }
                 let e = &mut active[k];
@@ -687,22 +773,14 @@ impl Correction for ContactSolver<'_> {
                 e.r_t = resp.r_t;
                 e.hist = resp.hist;
                 e.state = resp.state;
-                next = next_dirty(dirty, k + 1);
             }
             let mut max_du: f64 = 0.0;
             for &nd in touched.iter() {
-                max_du = max_du.max(sweep_du[nd as usize].norm());
-                sweep_du[nd as usize] = Vector3::zeros();
+                max_du = max_du.max(node[nd as usize].du.norm());
             }
             touched.clear();
-            converged = max_du <= *gs_tolerance || dirty.iter().all(|&w| w == 0);
+            converged = max_du <= *gs_tolerance || !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(node, a, e));
         }
-
-        for &nd in &self.adj_nodes {
-            self.adj_head[nd as usize] = u32::MAX;
-        }
-        self.adj_nodes.clear();
-        self.adj.clear();
 
         // ---------------------------------------------------------------- record
         let mut work = penalty_work;
@@ -717,7 +795,7 @@ impl Correction for ContactSolver<'_> {
             let j = &self.joints[a.joint as usize];
             let i = a.pair as usize;
             let [n, t1, t2] = j.frames[i];
-            let s = a.slave as usize;
+            let s = a.nodes[0] as usize;
             let p = &mut history.joints[a.joint as usize].pairs[i];
             p.hist = a.hist;
             p.state = a.state;
@@ -728,9 +806,9 @@ impl Correction for ContactSolver<'_> {
             let mut dum = Vector3::zeros();
             let mut duc = Vector3::zeros();
             for b in 0..a.nm as usize {
-                let mi = a.masters[b] as usize;
-                dum += (disp(u_next, mi) - disp(u, mi)) * a.weights[b];
-                duc += (disp(u_next, mi) - disp(u_prev, mi)) * (0.5 * a.weights[b]);
+                let mi = a.nodes[b + 1] as usize;
+                dum += (disp(u_next, mi) - disp(u, mi)) * a.coef[b + 1];
+                duc += (disp(u_next, mi) - disp(u_prev, mi)) * (0.5 * a.coef[b + 1]);
             }
             let dd = (disp(u_next, s) - disp(u, s)) - dum;
             p.d_t[0] += dd.dot(&t1);

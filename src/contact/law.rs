@@ -211,6 +211,7 @@ impl PairResponse {
 /// - `dt_trial`: trial relative tangential displacement increment over the step `Δd̃_t` (m), `(t1, t2)`.
 /// - `dt2w`: `dt² w` (m/N), must be > 0 (positive masses).
 /// - `area`: the slave node's tributary area `A_s` (m²).
+#[inline]
 pub fn pair_force(
     law: &JointLaw,
     hist: &PairHistory,
@@ -221,10 +222,14 @@ pub fn pair_force(
 ) -> PairResponse {
     debug_assert!(dt2w > 0.0, "dt² w must be positive, got {dt2w}");
     let k = dt2w;
+    // 1/k depends only on the pair, not on the trial quantities: computed first, it stays off
+    // the Gauss–Seidel chain (node update → trial gap → force → node update), where a division
+    // per pair update was the longest latency.
+    let inv_k = 1.0 / k;
     if law.tied {
         return PairResponse {
-            r_n: -g_trial / k,
-            r_t: -dt_trial / k,
+            r_n: -g_trial * inv_k,
+            r_t: -dt_trial * inv_k,
             state: PairState::Bonded,
             hist: *hist,
             slip_increment: Vector2::zeros(),
@@ -235,21 +240,21 @@ pub fn pair_force(
         let intact = hist.intact && (law.keep_cohesion || !law.breaks_by_opening(g_trial));
         return PairResponse::open(PairHistory { intact, ..*hist }, dt_trial);
     }
-    let r_n = -g_trial / k;
+    let r_n = -g_trial * inv_k;
     if r_n < -law.tensile_strength * area {
         // Tensile rupture (only reachable by a bonded pair): the bond is gone, the pair opens.
         return PairResponse::open(PairHistory { intact: false, ..*hist }, dt_trial);
     }
-    let r_trial = -dt_trial / k;
+    let r_trial = -dt_trial * inv_k;
     let limit = (law.mu * r_n + law.cohesion_force(hist, area)).max(0.0);
-    let r_trial_norm = r_trial.norm();
-    if r_trial_norm <= limit {
+    // stick when |r_trial| ≤ limit, compared through the squares (no root when it sticks)
+    if r_trial.norm_squared() <= limit * limit {
         let state = if bonded { PairState::Bonded } else { PairState::Stick };
         return PairResponse { r_n, r_t: r_trial, state, hist: *hist, slip_increment: Vector2::zeros() };
     }
     // Slip: back to the limit along the trial direction. As for an opening, a slip within
     // round-off (`open_tolerance`) does not break the bond.
-    let r_t = r_trial * (limit / r_trial_norm);
+    let r_t = r_trial * (limit / r_trial.norm());
     let slip_increment = dt_trial + r_t * k;
     let slip = hist.slip + slip_increment.norm();
     let intact = hist.intact && (law.keep_cohesion || !law.breaks_by_slip(slip_increment.norm(), slip));
