@@ -117,14 +117,9 @@ impl ContactState {
     }
 }
 
-/// Gauss–Seidel scratch of one node, kept together so that a pair update reads one place per
-/// node.
+/// Gauss–Seidel scratch of one node.
 #[derive(Clone, Copy, Debug, Default)]
 struct NodeScratch {
-    /// Displacement change [m] applied during the current sweep (valid when `sweep` equals the
-    /// solver's `sweep_clock`).
-    du: Vector3<f64>,
-    sweep: u32,
     /// The work list, as clocks: each pair update ticks the clock; `moved_at` is the tick at
     /// which the node was last moved (by more than the marking tolerance), and a pair's
     /// `evaluated_at` the tick of its last evaluation. A sweep evaluates only the pairs one of
@@ -134,6 +129,8 @@ struct NodeScratch {
     /// pair is cheaper than marking every pair on a moved node, which an earlier bit set with
     /// per-node lists did.)
     moved_at: u32,
+    /// The step (solver's `step_clock`) in which the node was put on the list of moving nodes.
+    listed: u32,
 }
 
 /// One active pair of the current step (scratch).
@@ -205,9 +202,12 @@ pub struct ContactSolver<'m> {
     node: Vec<NodeScratch>,
     /// Per active pair: the tick of its last evaluation (see [`NodeScratch::moved_at`]).
     evaluated_at: Vec<u32>,
-    /// Count of sweeps so far (all steps; `NodeScratch::sweep` compares with it).
-    sweep_clock: u32,
-    touched: Vec<u32>,
+    /// Count of steps so far (`NodeScratch::listed` compares with it).
+    step_clock: u32,
+    /// The moving nodes of the active pairs, and their displacement at the start of the sweep
+    /// (the convergence test takes the net change of each node over a sweep).
+    gs_nodes: Vec<u32>,
+    sweep_start: Vec<Vector3<f64>>,
 }
 
 impl<'m> ContactSolver<'m> {
@@ -216,7 +216,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, gs_colored: true, color_mask: vec![0; model.n_nodes()], colors: Vec::new(), order: Vec::new(), sorted: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), sweep_clock: 0, touched: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, gs_colored: true, color_mask: vec![0; model.n_nodes()], colors: Vec::new(), order: Vec::new(), sorted: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, gs_nodes: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -693,13 +693,25 @@ impl Correction for ContactSolver<'_> {
         }
         // every moving node of an active pair counts as moved at tick 1, every pair as last
         // evaluated at tick 0: the first sweep evaluates all
+        if self.step_clock == u32::MAX {
+            self.node.iter_mut().for_each(|ns| ns.listed = 0);
+            self.step_clock = 0;
+        }
+        self.step_clock += 1;
+        self.gs_nodes.clear();
         for a in &self.active {
             for &nd in &a.nodes[..a.nm as usize + 1] {
                 if self.inv_mass[nd as usize] > 0.0 {
-                    self.node[nd as usize].moved_at = 1;
+                    let ns = &mut self.node[nd as usize];
+                    ns.moved_at = 1;
+                    if ns.listed != self.step_clock {
+                        ns.listed = self.step_clock;
+                        self.gs_nodes.push(nd);
+                    }
                 }
             }
         }
+        self.sweep_start.resize(self.gs_nodes.len(), Vector3::zeros());
         self.evaluated_at.clear();
         self.evaluated_at.resize(self.active.len(), 0);
         let mut clock = 1u32;
@@ -709,17 +721,14 @@ impl Correction for ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, node, evaluated_at, sweep_clock, touched, gs_tolerance, gs_max_sweeps, .. } = self;
+        let ContactSolver { active, node, evaluated_at, gs_nodes, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
-            if *sweep_clock == u32::MAX {
-                node.iter_mut().for_each(|ns| ns.sweep = 0);
-                *sweep_clock = 0;
+            for (x0, &nd) in sweep_start.iter_mut().zip(gs_nodes.iter()) {
+                *x0 = node3(u_next, nd);
             }
-            *sweep_clock += 1;
-            let sweep_clock = *sweep_clock;
             for k in 0..active.len() {
                 let a = &active[k];
                 if !moved_since(node, a, evaluated_at[k]) {
@@ -742,30 +751,20 @@ impl Correction for ContactSolver<'_> {
                 let resp = pair_force(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.area);
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
-                if d_rn != 0.0 || d_rt.x != 0.0 || d_rt.y != 0.0 {
-                    // the pairs on the nodes this update moves must be evaluated again (a fixed
-                    // node never changes a neighbour's force)
-                    let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
-                    for b in 0..5 {
-                        // a fixed node or an unused entry has mobility 0: it does not move
-                        let nd = a.nodes[b] as usize;
-                        let du = dr * a.mob[b];
-                        if du.norm_squared() > mark_tol2 {
-                            node[nd].moved_at = clock;
-                        }
-                        let v = &mut u_next[3 * nd..3 * nd + 3];
-                        v[0] += du[0];
-                        v[1] += du[1];
-                        v[2] += du[2];
-                        let ns = &mut node[nd];
-                        if ns.sweep != sweep_clock {
-                            ns.sweep = sweep_clock;
-                            ns.du = du;
-                            touched.push(nd as u32);
-                        } else {
-                            ns.du += du;
-                        }
-                    }
+                // move the nodes by the force change (a fixed node or an unused entry has
+                // mobility 0 and does not move); the pairs on a node moved by more than the
+                // marking tolerance must be evaluated again (the clock only grows, so the max
+                // marks without a branch)
+                let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
+                for b in 0..5 {
+                    let nd = a.nodes[b] as usize;
+                    let du = dr * a.mob[b];
+                    let ns = &mut node[nd];
+                    ns.moved_at = ns.moved_at.max(clock * (du.norm_squared() > mark_tol2) as u32);
+                    let v = &mut u_next[3 * nd..3 * nd + 3];
+                    v[0] += du[0];
+                    v[1] += du[1];
+                    v[2] += du[2];
                 }
                 let e = &mut active[k];
                 e.gap = g_trial + e.dt2w * resp.r_n;
@@ -774,11 +773,11 @@ impl Correction for ContactSolver<'_> {
                 e.hist = resp.hist;
                 e.state = resp.state;
             }
-            let mut max_du: f64 = 0.0;
-            for &nd in touched.iter() {
-                max_du = max_du.max(node[nd as usize].du.norm());
+            let mut max_du2: f64 = 0.0;
+            for (x0, &nd) in sweep_start.iter().zip(gs_nodes.iter()) {
+                max_du2 = max_du2.max((node3(u_next, nd) - x0).norm_squared());
             }
-            touched.clear();
+            let max_du = max_du2.sqrt();
             converged = max_du <= *gs_tolerance || !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(node, a, e));
         }
 
