@@ -573,6 +573,29 @@ mod tests {
     }
 
     #[test]
+    fn quad_projection_from_a_start_matches_the_one_from_the_centre() {
+        // The search starts a node's Newton from its local coordinates of the last step. Reference:
+        // the projection from the centre on the same distorted quad; from any start in [-2, 2]²
+        // the same root to 1e-12 in ξ and m, same location; a start that is not finite or
+        // outside [-2, 2]² falls back to the centre and gives the centre's result bit for bit.
+        let x = [v(0.0, 0.0, 0.0), v(2.1, -0.2, 0.3), v(1.8, 1.9, -0.25), v(-0.3, 1.4, 0.2)];
+        let n = v(0.15, -0.1, -1.0).normalize();
+        let xq = [&x[0], &x[1], &x[2], &x[3]];
+        for &xs in &[v(0.7, 0.6, 0.8), v(1.5, 1.2, -0.3), v(0.1, 1.1, 0.05)] {
+            let centre = project_along_on_quad(&xs, &n, xq, TOL).unwrap().expect("inside");
+            for start in [centre.xi, [centre.xi[0] + 1e-4, centre.xi[1] - 1e-4], [-0.9, 0.9], [1.9, -1.9]] {
+                let p = project_along_on_quad_from(&xs, &n, xq, TOL, start).unwrap().expect("inside");
+                assert!((p.xi[0] - centre.xi[0]).abs() < 1e-12 && (p.xi[1] - centre.xi[1]).abs() < 1e-12, "{start:?}: {:?} vs {:?}", p.xi, centre.xi);
+                assert!((p.point - centre.point).norm() < 1e-12 && (p.t - centre.t).abs() < 1e-12);
+                assert_eq!(p.location, centre.location);
+            }
+            for bad in [[f64::NAN, 0.0], [3.0, 0.0], [0.0, f64::INFINITY]] {
+                assert_eq!(project_along_on_quad_from(&xs, &n, xq, TOL, bad).unwrap(), Some(centre.clone()));
+            }
+        }
+    }
+
+    #[test]
     fn distorted_quad_newton_matches_analytic() {
         // Non-planar, non-parallelogram quad; tilted normal. Reference: the two solves of the same
         // equations agree to 1e-10 in ξ and t, and Newton's 3D residual is below 1e-12 m.
