@@ -148,8 +148,10 @@ fn inside_outside(
     for e in 0..k {
         let (a, b) = (x[e], x[(e + 1) % k]);
         let edge = b - a;
-        let delta = n.dot(&edge.cross(&(p - a)));
-        let len2 = n.cross(&edge).norm_squared();
+        // Δ = n · (edge × (p − a)) = (n × edge) · (p − a): one cross product for Δ and the length
+        let c = n.cross(&edge);
+        let delta = c.dot(&(p - a));
+        let len2 = c.norm_squared();
         // Signed distance from the edge seen along n (positive inside): d = s Δ / |n × edge|,
         // compared with the band through its square (no root or division per edge). An edge
         // parallel to n has no extent in the view: the point is on it (d = 0).
