@@ -7,7 +7,9 @@
 //! `steps` steps of both models in turn (after 200 warm-up steps each), so that both see the
 //! same load from other users of the machine; best and median of the repeats are reported.
 //! The state after the warm-up and all the repeats is hashed (displacements and every pair's
-//! force, gap, slip), so that two builds can be compared for identical results.
+//! force, gap, slip), so that two builds can be compared for identical results. The contact
+//! correction's own timers (`ContactSolver::timings`) split its time into search and set-up,
+//! warm start and colouring, sweeps and record.
 //! Run: `cargo bench --bench contact`. Knobs (environment):
 //! - `JQ_BENCH_N`: n, default 40 → about 10 % of the nodes are slave nodes;
 //! - `JQ_BENCH_REPEATS`: timed repeats, default 5 (at least 3);
@@ -125,6 +127,8 @@ fn main() {
         a.steps(200);
         b.steps(200);
         b.sweeps = 0;
+        // time the parts of the contact correction over the repeats
+        b.contact.as_mut().unwrap().timings = Some(Default::default());
         let (mut t_free, mut t_with, mut per_pair, mut ratio) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut active = Vec::new();
         for _ in 0..repeats {
@@ -146,6 +150,10 @@ fn main() {
         println!("  step with contact   {:9.1} / {:9.1} µs", best(&t_with), median(&t_with));
         println!("  ratio               {:9.2} / {:9.2}  (target ≤ 1.5)", best(&ratio), median(&ratio));
         println!("  per active pair     {:9.3} / {:9.3} µs per step (target ≤ 1 µs), Gauss–Seidel sweeps {sweeps:.1} per step", best(&per_pair), median(&per_pair));
+        let parts = b.contact.as_ref().unwrap().timings.clone().unwrap();
+        let per_step = |d: std::time::Duration| 1e6 * d.as_secs_f64() / parts.steps.max(1) as f64;
+        let (t_search, t_prepare, t_sweeps, t_record) = (per_step(parts.search), per_step(parts.prepare), per_step(parts.sweeps), per_step(parts.record));
+        println!("  contact part, mean over the repeats: search and set-up {t_search:.1} µs, warm start and colouring {t_prepare:.1} µs, sweeps {t_sweeps:.1} µs, record {t_record:.1} µs per step");
         println!("  state hash after {} steps: {:016x}", 200 + repeats * steps, b.state_hash());
         let json = serde_json::json!({
             "load_before": load, "n": n, "nodes": with.n_nodes(), "elements": with.n_elements(), "slave_nodes": slaves,
@@ -154,6 +162,7 @@ fn main() {
             "best": {"step_contact_free_us": best(&t_free), "step_with_contact_us": best(&t_with), "overhead_ratio": best(&ratio), "per_pair_us": best(&per_pair)},
             "median": {"step_contact_free_us": median(&t_free), "step_with_contact_us": median(&t_with), "overhead_ratio": median(&ratio), "per_pair_us": median(&per_pair)},
             "sweeps_per_step": sweeps, "state_hash": format!("{:016x}", b.state_hash()),
+            "contact_parts_us_per_step": {"search": t_search, "prepare": t_prepare, "sweeps": t_sweeps, "record": t_record},
         });
         let _ = std::fs::create_dir_all("target/bench");
         let _ = std::fs::write("target/bench/contact.json", serde_json::to_string_pretty(&json).unwrap());

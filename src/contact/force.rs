@@ -166,6 +166,22 @@ struct Active {
     moving: u8,
 }
 
+/// Wall time spent in the parts of the contact correction, summed over the steps since it was
+/// switched on ([`ContactSolver::timings`]); for benchmarks and profiling.
+#[derive(Clone, Debug, Default)]
+pub struct ContactTimings {
+    /// Search and the set-up of the active pairs (and the penalty forces).
+    pub search: std::time::Duration,
+    /// Warm start, colouring and the Gauss–Seidel lists.
+    pub prepare: std::time::Duration,
+    /// The Gauss–Seidel sweeps.
+    pub sweeps: std::time::Duration,
+    /// Writing the pairs' results into the history.
+    pub record: std::time::Duration,
+    /// Steps timed.
+    pub steps: u64,
+}
+
 /// Scratch and settings of the contact correction. Holds no history (that is in `ContactState`).
 pub struct ContactSolver<'m> {
     pub joints: &'m [ContactJoint],
@@ -189,6 +205,8 @@ pub struct ContactSolver<'m> {
     /// opening, as with `keep_cohesion`; a tensile rupture still ends it. Default false. The
     /// pipeline sets it during gravity equilibrium (scene `equilibrium.joint_bonds = "kept"`).
     pub keep_bonds: bool,
+    /// When `Some`, each step adds the time of its parts (default `None`: no clock read).
+    pub timings: Option<ContactTimings>,
     active: Vec<Active>,
     /// Scratch of [`Self::order_by_color`]: per node the colours of its pairs, per pair its colour.
     color_mask: Vec<u64>,
@@ -216,7 +234,7 @@ impl<'m> ContactSolver<'m> {
         let inv_mass = (0..model.n_nodes())
             .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, gs_colored: true, color_mask: vec![0; model.n_nodes()], colors: Vec::new(), order: Vec::new(), sorted: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, gs_nodes: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: vec![0; model.n_nodes()], colors: Vec::new(), order: Vec::new(), sorted: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, gs_nodes: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -443,6 +461,9 @@ impl Correction for ContactSolver<'_> {
         u_next: &mut [f64],
     ) -> Result<CorrectionInfo, StepError> {
         let dt2 = dt * dt;
+        let now_if = |on: bool| on.then(std::time::Instant::now);
+        let timed = self.timings.is_some();
+        let t_search = now_if(timed);
         self.active.clear();
         self.penalty.clear();
         let mut penalty_work = 0.0;
@@ -688,6 +709,7 @@ impl Correction for ContactSolver<'_> {
                 add_pair_force_into(u_next, &self.inv_mass, dt2, a.nodes[0], &a.nodes[1..a.nm as usize + 1], &weights, &r);
             }
         }
+        let t_prepare = now_if(timed);
         if self.gs_colored {
             self.order_by_color();
         }
@@ -721,6 +743,7 @@ impl Correction for ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
+        let t_sweeps = now_if(timed);
         let ContactSolver { active, node, evaluated_at, gs_nodes, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
@@ -781,6 +804,7 @@ impl Correction for ContactSolver<'_> {
             converged = max_du <= *gs_tolerance || !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(node, a, e));
         }
 
+        let t_record = now_if(timed);
         // ---------------------------------------------------------------- record
         let mut work = penalty_work;
         for rec in history.joints.iter_mut() {
@@ -816,6 +840,13 @@ impl Correction for ContactSolver<'_> {
             let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
             let du = (disp(u_next, s) - disp(u_prev, s)) * 0.5 - duc;
             work += rvec.dot(&du);
+        }
+        if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {
+            t.search += b - a;
+            t.prepare += c - b;
+            t.sweeps += d - c;
+            t.record += d.elapsed();
+            t.steps += 1;
         }
         Ok(CorrectionInfo { work, iterations: sweeps })
     }
