@@ -157,13 +157,12 @@ struct Active {
     /// The pair's nodes, slave first then its `nm` masters, their coefficients in
     /// Σ N_I u_I − u_s (−1 for the slave, N_I for the masters), and the displacement a unit
     /// pair force gives each over one step (dt²/m_s for the slave, −dt² N_I/m_I for the masters,
-    /// 0 at a fixed node; `moving` bit b set when node b is free, i.e. 1/m > 0). Always five
+    /// 0 at a fixed node). Always five
     /// entries, so that the Gauss–Seidel update has no loop bounds to test: entries past the
     /// masters repeat the slave with coefficient and mobility 0.
     nodes: [u32; 5],
     coef: [f64; 5],
     mob: [f64; 5],
-    moving: u8,
 }
 
 /// Wall time spent in the parts of the contact correction, summed over the steps since it was
@@ -273,17 +272,12 @@ impl<'m> ContactSolver<'m> {
         let mut count = [0usize; 64];
         self.colors.clear();
         for a in &self.active {
-            let mut used = 0u64;
-            for b in 0..a.nm as usize + 1 {
-                if a.moving & (1 << b) != 0 {
-                    used |= self.color_mask[a.nodes[b] as usize];
-                }
-            }
+            let free = |nd: &&u32| self.inv_mass[**nd as usize] > 0.0;
+            let nodes = &a.nodes[..a.nm as usize + 1];
+            let used = nodes.iter().filter(free).fold(0u64, |m, &nd| m | self.color_mask[nd as usize]);
             let c = (!used).trailing_zeros().min(63);
-            for b in 0..a.nm as usize + 1 {
-                if a.moving & (1 << b) != 0 {
-                    self.color_mask[a.nodes[b] as usize] |= 1u64 << c;
-                }
+            for &nd in nodes.iter().filter(free) {
+                self.color_mask[nd as usize] |= 1u64 << c;
             }
             self.colors.push(c as u8);
             count[c as usize] += 1;
@@ -337,7 +331,8 @@ fn pos(model: &Model, u: &[f64], n: usize) -> Vector3<f64> {
 
 #[inline]
 fn disp(u: &[f64], n: usize) -> Vector3<f64> {
-    Vector3::new(u[3 * n], u[3 * n + 1], u[3 * n + 2])
+    let v = &u[3 * n..3 * n + 3];
+    Vector3::new(v[0], v[1], v[2])
 }
 
 /// Project slave node `i` of joint `j` on the master faces `faces` at the positions `u`.
@@ -440,13 +435,6 @@ fn add_pair_force_into(u: &mut [f64], inv_mass: &[f64], dt2: f64, slave: u32, ma
 #[inline(always)]
 fn moved_since(node: &[NodeScratch], a: &Active, since: u32) -> bool {
     a.nodes.iter().fold(0, |m, &nd| m.max(node[nd as usize].moved_at)) > since
-}
-
-#[inline(always)]
-fn node3(u: &[f64], nd: u32) -> Vector3<f64> {
-    let i = 3 * nd as usize;
-    let v = &u[i..i + 3];
-    Vector3::new(v[0], v[1], v[2])
 }
 
 impl Correction for ContactSolver<'_> {
@@ -644,10 +632,8 @@ impl Correction for ContactSolver<'_> {
                 let mut nodes5 = [s as u32; 5];
                 let mut coef = [-1.0, 0.0, 0.0, 0.0, 0.0];
                 let mut mob = [0.0; 5];
-                let mut moving = 0u8;
                 if self.inv_mass[s] > 0.0 {
                     mob[0] = dt2 * self.inv_mass[s];
-                    moving |= 1;
                 }
                 for b in 0..nm as usize {
                     let mi = masters[b] as usize;
@@ -656,14 +642,12 @@ impl Correction for ContactSolver<'_> {
                     let imi = self.inv_mass[mi];
                     if imi > 0.0 {
                         mob[b + 1] = -dt2 * weights[b] * imi;
-                        moving |= 1 << (b + 1);
                     }
                 }
                 self.active.push(Active {
                     nodes: nodes5,
                     coef,
                     mob,
-                    moving,
                     frame: j.frames[i],
                     area: j.tag.areas[i],
                     hist0: pr.hist,
@@ -750,7 +734,7 @@ impl Correction for ContactSolver<'_> {
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
             for (x0, &nd) in sweep_start.iter_mut().zip(gs_nodes.iter()) {
-                *x0 = node3(u_next, nd);
+                *x0 = disp(u_next, nd as usize);
             }
             for k in 0..active.len() {
                 let a = &active[k];
@@ -764,7 +748,7 @@ impl Correction for ContactSolver<'_> {
                 // always: unused entries repeat the slave with coefficient and mobility 0)
                 let mut rel = Vector3::zeros();
                 for b in 0..5 {
-                    rel += node3(u_next, a.nodes[b]) * a.coef[b];
+                    rel += disp(u_next, a.nodes[b] as usize) * a.coef[b];
                 }
                 let g_cur = a.gap0 + n.dot(&rel);
                 let dd = a.rel_u - rel;
@@ -798,7 +782,7 @@ impl Correction for ContactSolver<'_> {
             }
             let mut max_du2: f64 = 0.0;
             for (x0, &nd) in sweep_start.iter().zip(gs_nodes.iter()) {
-                max_du2 = max_du2.max((node3(u_next, nd) - x0).norm_squared());
+                max_du2 = max_du2.max((disp(u_next, nd as usize) - x0).norm_squared());
             }
             let max_du = max_du2.sqrt();
             converged = max_du <= *gs_tolerance || !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(node, a, e));
@@ -815,9 +799,8 @@ impl Correction for ContactSolver<'_> {
             }
         }
         for a in &self.active {
-            let j = &self.joints[a.joint as usize];
             let i = a.pair as usize;
-            let [n, t1, t2] = j.frames[i];
+            let [n, t1, t2] = a.frame;
             let s = a.nodes[0] as usize;
             let p = &mut history.joints[a.joint as usize].pairs[i];
             p.hist = a.hist;
