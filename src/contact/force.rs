@@ -431,27 +431,39 @@ fn add_pair_force_into(u: &mut [f64], inv_mass: &[f64], dt2: f64, slave: u32, ma
     }
 }
 
+/// The largest squared net change of the nodes `nodes` since `start` (their displacements at the
+/// start of the sweep), with `start` updated to the current displacements for the next sweep.
+/// Four running maxima, so that the loop is not one chain of dependent comparisons (one
+/// `f64::max` chain and a separate snapshot pass were a quarter of the Gauss–Seidel time). Like
+/// `f64::max`, a NaN change is not taken (the step's finiteness check reports non-finite
+/// displacements).
+fn sweep_change_into(u: &[f64], nodes: &[u32], start: &mut [Vector3<f64>]) -> f64 {
+    let mut m = [0.0f64; 4];
+    for (x0s, nds) in start.chunks_mut(4).zip(nodes.chunks(4)) {
+        for (lane, (x0, &nd)) in x0s.iter_mut().zip(nds).enumerate() {
+            let x = disp(u, nd as usize);
+            let d = (x - *x0).norm_squared();
+            if d > m[lane] {
+                m[lane] = d;
+            }
+            *x0 = x;
+        }
+    }
+    m[0].max(m[1]).max(m[2].max(m[3]))
+}
+
 /// Whether active pair `a`, last evaluated at tick `since`, has a node moved after it.
 #[inline(always)]
 fn moved_since(node: &[NodeScratch], a: &Active, since: u32) -> bool {
     a.nodes.iter().fold(0, |m, &nd| m.max(node[nd as usize].moved_at)) > since
 }
 
-impl Correction for ContactSolver<'_> {
-    fn correct(
-        &mut self,
-        model: &Model,
-        history: &mut ContactState,
-        _t_next: f64,
-        dt: f64,
-        u_prev: &[f64],
-        u: &[f64],
-        u_next: &mut [f64],
-    ) -> Result<CorrectionInfo, StepError> {
-        let dt2 = dt * dt;
-        let now_if = |on: bool| on.then(std::time::Instant::now);
-        let timed = self.timings.is_some();
-        let t_search = now_if(timed);
+impl ContactSolver<'_> {
+    /// Search and set-up (the first part of a step): every slave node's pair on the prediction
+    /// `u_next` (or on `u` for a penalty joint), the active list of the dynamic-force pairs,
+    /// and the penalty forces of step n applied to the prediction. Returns the penalty work [J].
+    #[inline(never)] // out of line, so that profiles show the four parts of a step
+    fn search_into(&mut self, model: &Model, history: &mut ContactState, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> f64 {
         self.active.clear();
         self.penalty.clear();
         let mut penalty_work = 0.0;
@@ -682,8 +694,13 @@ impl Correction for ContactSolver<'_> {
             }
             penalty_work += rvec.dot(&du);
         }
+        penalty_work
+    }
 
-        // ---------------------------------------------------------------- Gauss–Seidel
+    /// Warm start (each active pair's force of the last step applied to the prediction),
+    /// colour order and the Gauss–Seidel lists of moving nodes.
+    #[inline(never)]
+    fn prepare_sweeps_into(&mut self, u_next: &mut [f64], dt2: f64) {
         // the warm-start forces act on the prediction before the first sweep
         for a in &self.active {
             if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
@@ -693,7 +710,6 @@ impl Correction for ContactSolver<'_> {
                 add_pair_force_into(u_next, &self.inv_mass, dt2, a.nodes[0], &a.nodes[1..a.nm as usize + 1], &weights, &r);
             }
         }
-        let t_prepare = now_if(timed);
         if self.gs_colored {
             self.order_by_color();
         }
@@ -720,6 +736,12 @@ impl Correction for ContactSolver<'_> {
         self.sweep_start.resize(self.gs_nodes.len(), Vector3::zeros());
         self.evaluated_at.clear();
         self.evaluated_at.resize(self.active.len(), 0);
+    }
+
+    /// The Gauss–Seidel sweeps over the active pairs; returns the sweeps made and whether they
+    /// reached `gs_tolerance`.
+    #[inline(never)]
+    fn sweep_into(&mut self, u_next: &mut [f64]) -> (usize, bool) {
         let mut clock = 1u32;
         // A node moved by less than 1 % of the tolerance does not call its pairs back: their
         // forces would change by a fraction of that (the fixed point is the same to within the
@@ -727,15 +749,14 @@ impl Correction for ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let t_sweeps = now_if(timed);
         let ContactSolver { active, node, evaluated_at, gs_nodes, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
+        for (x0, &nd) in sweep_start.iter_mut().zip(gs_nodes.iter()) {
+            *x0 = disp(u_next, nd as usize);
+        }
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
-            for (x0, &nd) in sweep_start.iter_mut().zip(gs_nodes.iter()) {
-                *x0 = disp(u_next, nd as usize);
-            }
             for k in 0..active.len() {
                 let a = &active[k];
                 if !moved_since(node, a, evaluated_at[k]) {
@@ -763,11 +784,13 @@ impl Correction for ContactSolver<'_> {
                 // marking tolerance must be evaluated again (the clock only grows, so the max
                 // marks without a branch)
                 let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
+                // |du|² = |dr|² mob²: one norm per pair instead of one per node
+                let dr2 = dr.norm_squared();
                 for b in 0..5 {
                     let nd = a.nodes[b] as usize;
                     let du = dr * a.mob[b];
                     let ns = &mut node[nd];
-                    ns.moved_at = ns.moved_at.max(clock * (du.norm_squared() > mark_tol2) as u32);
+                    ns.moved_at = ns.moved_at.max(clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
                     let v = &mut u_next[3 * nd..3 * nd + 3];
                     v[0] += du[0];
                     v[1] += du[1];
@@ -780,17 +803,17 @@ impl Correction for ContactSolver<'_> {
                 e.hist = resp.hist;
                 e.state = resp.state;
             }
-            let mut max_du2: f64 = 0.0;
-            for (x0, &nd) in sweep_start.iter().zip(gs_nodes.iter()) {
-                max_du2 = max_du2.max((disp(u_next, nd as usize) - x0).norm_squared());
-            }
-            let max_du = max_du2.sqrt();
+            let max_du = sweep_change_into(u_next, gs_nodes, sweep_start).sqrt();
             converged = max_du <= *gs_tolerance || !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(node, a, e));
         }
+        (sweeps, converged)
+    }
 
-        let t_record = now_if(timed);
-        // ---------------------------------------------------------------- record
-        let mut work = penalty_work;
+    /// Write the active pairs' results into the history and return the contact work of the
+    /// step [J].
+    #[inline(never)]
+    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, u_prev: &[f64], u: &[f64], u_next: &[f64]) -> f64 {
+        let mut work = 0.0;
         for rec in history.joints.iter_mut() {
             rec.sweeps = sweeps;
             rec.max_sweeps = rec.max_sweeps.max(sweeps);
@@ -824,6 +847,32 @@ impl Correction for ContactSolver<'_> {
             let du = (disp(u_next, s) - disp(u_prev, s)) * 0.5 - duc;
             work += rvec.dot(&du);
         }
+        work
+    }
+}
+
+impl Correction for ContactSolver<'_> {
+    fn correct(
+        &mut self,
+        model: &Model,
+        history: &mut ContactState,
+        _t_next: f64,
+        dt: f64,
+        u_prev: &[f64],
+        u: &[f64],
+        u_next: &mut [f64],
+    ) -> Result<CorrectionInfo, StepError> {
+        let dt2 = dt * dt;
+        let now_if = |on: bool| on.then(std::time::Instant::now);
+        let timed = self.timings.is_some();
+        let t_search = now_if(timed);
+        let penalty_work = self.search_into(model, history, dt2, u_prev, u, u_next);
+        let t_prepare = now_if(timed);
+        self.prepare_sweeps_into(u_next, dt2);
+        let t_sweeps = now_if(timed);
+        let (sweeps, converged) = self.sweep_into(u_next);
+        let t_record = now_if(timed);
+        let work = penalty_work + self.record_into(history, sweeps, converged, u_prev, u, u_next);
         if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {
             t.search += b - a;
             t.prepare += c - b;
