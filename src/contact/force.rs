@@ -25,7 +25,7 @@
 //! external force of step n (so it is explicit and lowers the stable step).
 
 use super::joint::{ContactJoint, Method, OnExit};
-use super::law::{pair_force, penalty_force, JointLaw, PairHistory, PairState};
+use super::law::{pair_force_with_inverse, penalty_force, JointLaw, PairHistory, PairState};
 use super::query::{project_along_on_quad_from, project_along_on_tri, select_projection, Location, INSIDE_TOL_DEFAULT};
 use crate::dynamics::{Correction, CorrectionInfo};
 use crate::error::StepError;
@@ -140,6 +140,8 @@ struct Active {
     pair: u32,
     nm: u8,
     dt2w: f64,
+    /// 1 / dt2w (one division per pair and step, not per update).
+    inv_dt2w: f64,
     /// Applied force components (r_n compressive, r_t) of the current Gauss–Seidel iterate.
     r_n: f64,
     r_t: Vector2<f64>,
@@ -669,6 +671,7 @@ impl ContactSolver<'_> {
                     pair: i as u32,
                     nm,
                     dt2w: dt2 * w,
+                    inv_dt2w: 1.0 / (dt2 * w),
                     // warm start: a pair in contact at the last step starts from its last force
                     r_n: if warm { pr.r_n } else { 0.0 },
                     r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
@@ -776,7 +779,7 @@ impl ContactSolver<'_> {
                 // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
                 let g_trial = g_cur - a.dt2w * a.r_n;
                 let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-                let resp = pair_force(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.area);
+                let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
                 let d_rn = resp.r_n - a.r_n;
                 let d_rt = resp.r_t - a.r_t;
                 // move the nodes by the force change (a fixed node or an unused entry has

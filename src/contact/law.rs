@@ -220,12 +220,26 @@ pub fn pair_force(
     dt2w: f64,
     area: f64,
 ) -> PairResponse {
+    pair_force_with_inverse(law, hist, g_trial, dt_trial, dt2w, 1.0 / dt2w, area)
+}
+
+/// [`pair_force`] with `1 / dt2w` given (`inv_dt2w`): the Gauss–Seidel sweeps compute it once
+/// per pair and step instead of once per pair update. 1/k depends only on the pair, not on the
+/// trial quantities; off the Gauss–Seidel chain (node update → trial gap → force → node update)
+/// it costs no latency, but a division per update was still a tenth of a sweep's time.
+#[inline]
+pub fn pair_force_with_inverse(
+    law: &JointLaw,
+    hist: &PairHistory,
+    g_trial: f64,
+    dt_trial: Vector2<f64>,
+    dt2w: f64,
+    inv_dt2w: f64,
+    area: f64,
+) -> PairResponse {
     debug_assert!(dt2w > 0.0, "dt² w must be positive, got {dt2w}");
     let k = dt2w;
-    // 1/k depends only on the pair, not on the trial quantities: computed first, it stays off
-    // the Gauss–Seidel chain (node update → trial gap → force → node update), where a division
-    // per pair update was the longest latency.
-    let inv_k = 1.0 / k;
+    let inv_k = inv_dt2w;
     if law.tied {
         return PairResponse {
             r_n: -g_trial * inv_k,
