@@ -337,6 +337,45 @@ fn disp(u: &[f64], n: usize) -> Vector3<f64> {
     Vector3::new(v[0], v[1], v[2])
 }
 
+/// Project on one master face `f` (the face of the last step, or a candidate set of one): no
+/// candidate buffer, no selection, and a quad's Newton starts from the node's local coordinates
+/// of the last step (`xi0`). Also returns the squared length of the face's first edge (the
+/// search's test of nearness along the normal).
+#[allow(clippy::too_many_arguments)]
+fn project_on_face(
+    model: &Model,
+    j: &ContactJoint,
+    f: usize,
+    xs: &Vector3<f64>,
+    n: &Vector3<f64>,
+    u: &[f64],
+    failures: &mut u64,
+    tol: f64,
+    xi0: [f64; 2],
+) -> Option<(super::query::Projection, f64)> {
+    let nodes = j.tag.master.faces[f].nodes();
+    let mut x = [Vector3::zeros(); 4];
+    for (a, &nd) in nodes.iter().enumerate() {
+        x[a] = pos(model, u, nd as usize);
+    }
+    let edge2 = (x[1] - x[0]).norm_squared();
+    let p = match nodes.len() {
+        3 => project_along_on_tri(xs, n, [&x[0], &x[1], &x[2]], tol),
+        4 => match project_along_on_quad_from(xs, n, [&x[0], &x[1], &x[2], &x[3]], tol, xi0) {
+            Ok(p) => p,
+            Err(_) => {
+                *failures += 1;
+                None
+            }
+        },
+        _ => {
+            *failures += 1;
+            None
+        }
+    };
+    p.map(|p| (p, edge2))
+}
+
 /// Project slave node `i` of joint `j` on the master faces `faces` at the positions `u`.
 fn project_on(
     model: &Model,
@@ -351,28 +390,7 @@ fn project_on(
 ) -> Option<(usize, super::query::Projection)> {
     let m = &j.tag.master;
     if let [f] = faces {
-        // one face (the face of the last step): no candidate buffer, no selection, and a quad's
-        // Newton starts from the node's local coordinates of the last step (`xi0`)
-        let face = &m.faces[*f as usize];
-        let nodes = face.nodes();
-        let mut x = [Vector3::zeros(); 4];
-        for (a, &nd) in nodes.iter().enumerate() {
-            x[a] = pos(model, u, nd as usize);
-        }
-        return match nodes.len() {
-            3 => project_along_on_tri(xs, n, [&x[0], &x[1], &x[2]], tol).map(|p| (*f as usize, p)),
-            4 => match project_along_on_quad_from(xs, n, [&x[0], &x[1], &x[2], &x[3]], tol, xi0) {
-                Ok(p) => p.map(|p| (*f as usize, p)),
-                Err(_) => {
-                    *failures += 1;
-                    None
-                }
-            },
-            _ => {
-                *failures += 1;
-                None
-            }
-        };
+        return project_on_face(model, j, *f as usize, xs, n, u, failures, tol, xi0).map(|(p, _)| (*f as usize, p));
     }
     // candidate sets are small (Layer2 of a structured quad mesh: 16 faces); the stack buffer
     // avoids an allocation per node and step, larger sets fall back to the heap
@@ -494,14 +512,11 @@ impl ContactSolver<'_> {
                         let mut found = None;
                         if pr.face >= 0 {
                             let f = pr.face as usize;
-                            if let Some((ff, p)) = project_on(model, j, &[f as u32], &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
+                            if let Some((p, edge2)) = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
                                 && p.location == Location::Inside
+                                && p.t * p.t <= 0.25 * edge2
                             {
-                                let x0 = pos(model, conf, j.tag.master.faces[f].nodes()[0] as usize);
-                                let x1 = pos(model, conf, j.tag.master.faces[f].nodes()[1] as usize);
-                                if p.t * p.t <= 0.25 * (x1 - x0).norm_squared() {
-                                    found = Some((ff, p));
-                                }
+                                found = Some((f, p));
                             }
                         }
                         if found.is_none() {

@@ -127,6 +127,29 @@ fn face_size(x: &[Vector3<f64>]) -> f64 {
     (0..n).map(|e| (x[(e + 1) % n] - x[e]).norm_squared()).fold(0.0, f64::max).sqrt()
 }
 
+/// `n` normalised; `n` itself when it is already unit to round-off (a slave normal always is),
+/// which saves a root and a division per projection. `None` for a zero vector.
+fn unit(n: &Vector3<f64>) -> Option<Vector3<f64>> {
+    if (n.norm_squared() - 1.0).abs() <= 8.0 * f64::EPSILON { Some(*n) } else { n.try_normalize(0.0) }
+}
+
+/// The sign of `n · m` (which side of the face `n` sees, for the inside test), or `None` when the
+/// face is degenerate (`|m| ≤ 1e-14 h²`, `m` the face normal of length twice the area for a
+/// triangle, the diagonals' cross product for a quad) or seen edge-on (`|n · m̂| <`
+/// [`PARALLEL_COS`]). Compared through squares: no root or division.
+fn facing_sign(n: &Vector3<f64>, m: &Vector3<f64>, h: f64) -> Option<f64> {
+    let m2 = m.norm_squared();
+    let h2 = h * h;
+    if m2.is_nan() || m2 <= 1e-28 * h2 * h2 {
+        return None;
+    }
+    let nm = n.dot(m);
+    if nm * nm < PARALLEL_COS * PARALLEL_COS * m2 {
+        return None;
+    }
+    Some(nm.signum())
+}
+
 fn all_finite(v: &[Vector3<f64>]) -> bool {
     v.iter().all(|p| p.iter().all(|c| c.is_finite()))
 }
@@ -196,26 +219,18 @@ pub fn project_along_on_tri(
     if !all_finite(&nodes) || !all_finite(&[*xs, *n]) {
         return None;
     }
-    let n = n.try_normalize(0.0)?;
+    let n = unit(n)?;
     let m = (b - a).cross(&(c - a)); // right-hand normal, |m| = 2 area
-    let m_norm = m.norm();
     let h = face_size(&nodes);
-    if m_norm.is_nan() || m_norm <= 1e-14 * h * h {
-        return None; // degenerate triangle
-    }
-    let cos = n.dot(&m) / m_norm;
-    if cos.abs() < PARALLEL_COS {
-        return None;
-    }
+    let s = facing_sign(&n, &m, h)?;
     // Plane m · (x − a) = 0 with x = xs + t n.
     let t = m.dot(&(a - xs)) / n.dot(&m);
     let p = xs + n * t;
-    let s = cos.signum();
     let location = inside_outside(&nodes, &n, &p, s, h, tol)?;
     // Barycentric weights: sub-triangle areas over the total area (signed, exact on the plane).
-    let m2 = m_norm * m_norm;
-    let w0 = m.dot(&(b - p).cross(&(c - p))) / m2;
-    let w1 = m.dot(&(c - p).cross(&(a - p))) / m2;
+    let inv_m2 = 1.0 / m.norm_squared();
+    let w0 = m.dot(&(b - p).cross(&(c - p))) * inv_m2;
+    let w1 = m.dot(&(c - p).cross(&(a - p))) * inv_m2;
     let w2 = 1.0 - w0 - w1;
     Some(Projection { point: p, t, gap: t, xi: [w1, w2], weights: [w0, w1, w2, 0.0], n_nodes: 3, location })
 }
@@ -269,9 +284,9 @@ enum Newton {
 
 /// Solve `[a b c] x = r` by Cramer's rule (the 3 × 3 Jacobian of the quad projection; cheaper
 /// than an LU factorisation with pivoting, which was a sixth of the contact search's time), with
-/// one division. Returns the solution, the determinant and `b × c` (the caller bounds the next
-/// Newton step with them). `None` when the determinant is zero or the solution is not finite
-/// (a singular Jacobian: the normal lies in the quad's tangent plane).
+/// one division. Returns the solution, `1 / det` and `b × c` (the chord steps of
+/// [`quad_local_newton`] reuse them). `None` when the determinant is zero or the solution is not
+/// finite (a singular Jacobian: the normal lies in the quad's tangent plane).
 fn solve_3x3_by_columns(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>, r: &Vector3<f64>) -> Option<(Vector3<f64>, f64, Vector3<f64>)> {
     let bc = b.cross(c);
     let det = a.dot(&bc);
@@ -280,52 +295,68 @@ fn solve_3x3_by_columns(a: &Vector3<f64>, b: &Vector3<f64>, c: &Vector3<f64>, r:
     }
     let inv = 1.0 / det;
     let x = Vector3::new(r.dot(&bc) * inv, a.dot(&r.cross(c)) * inv, a.dot(&b.cross(r)) * inv);
-    x.iter().all(|v| v.is_finite()).then_some((x, det, bc))
+    x.iter().all(|v| v.is_finite()).then_some((x, inv, bc))
 }
 
+/// Chord steps after a Newton step, before a full Newton step is taken again.
+const QUAD_CHORD_MAX_STEPS: usize = 6;
+
 /// Newton on `x(ξ) − xs − t n = 0` for `(ξ1, ξ2, t)`, from `xi0` (the centre, or the node's
-/// local coordinates of the last step). `n` unit, `h` face size.
+/// local coordinates of the last step). `n` unit, `h` face size. Converged when a step is below
+/// [`QUAD_NEWTON_STEP_TOL`].
 ///
-/// Stop: when the step is below [`QUAD_NEWTON_STEP_TOL`], or when the next step is certainly
-/// ten times below it. The map is bilinear, so after a step `s` the residual is exactly
-/// `c12 s1 s2` (the only term of second order); by Cramer's rule the next step is then at most
-/// `|c12 s1 s2| max(|b × n|, |a|, |a| |b| / h) / |det|` in the step measure (a, b the Jacobian's
-/// ξ columns, det its determinant). Evaluated with the Jacobian of the step just taken, which the
-/// step changes by `c12 s` — below 0.1 % under the `size < 1e-3` guard. A node that stays on its
-/// face starts within a predicted slip of the root and so usually stops after one solve.
+/// Near the root (a step below 1e-3) it goes on with chord steps, which need no new residual or
+/// Jacobian: the map is bilinear, so after a step `s` from the point `ξ_J` where the Jacobian J
+/// was taken the residual is exactly `ρ c12` with `ρ = s1 s2`, and after a chord step `s` from
+/// `ξ_J + δ` it is `ρ c12` with `ρ = δ2 s1 + δ1 s2 + s1 s2`. So every chord step is
+/// `−ρ J⁻¹ c12`, with `J⁻¹ c12` solved once. They contract by about `|c12| |δ| |J⁻¹|` (1e-8 on
+/// a node that stays on its face); if they do not reach the tolerance, full Newton steps resume.
 fn quad_local_newton(q: &Bilinear, xs: &Vector3<f64>, n: &Vector3<f64>, h: f64, max_iter: usize, xi0: [f64; 2]) -> Newton {
+    let inv_h = 1.0 / h;
     let mut xi = xi0;
     let p0 = q.at(xi) - xs;
     let mut t = n.dot(&p0);
     let mut f = p0 - n * t;
     let residual = |xi: [f64; 2], t: f64| q.at(xi) - xs - n * t;
-    let c12_2 = q.c12.norm_squared();
-    let next_tol2 = (0.1 * QUAD_NEWTON_STEP_TOL) * (0.1 * QUAD_NEWTON_STEP_TOL);
+    let size_of = |s: &Vector3<f64>| s[0].abs().max(s[1].abs()).max(s[2].abs() * inv_h);
+    let ok = |xi: [f64; 2], t: f64| xi[0].abs() < 1e6 && xi[1].abs() < 1e6 && t.is_finite();
+    let c = -n;
     for it in 0..max_iter {
         if it > 0 {
             f = residual(xi, t);
         }
         let (ja, jb) = (q.c1 + q.c12 * xi[1], q.c2 + q.c12 * xi[0]);
-        let Some((step, det, bc)) = solve_3x3_by_columns(&ja, &jb, &(-n), &(-f)) else {
+        let Some((step, inv, bc)) = solve_3x3_by_columns(&ja, &jb, &c, &(-f)) else {
             return Newton::Failed { iterations: it, residual: f.norm() };
         };
         xi[0] += step[0];
         xi[1] += step[1];
         t += step[2];
-        if !(xi[0].abs() < 1e6 && xi[1].abs() < 1e6 && t.is_finite()) {
+        if !ok(xi, t) {
             return Newton::Failed { iterations: it + 1, residual: f64::INFINITY };
         }
-        let size = step[0].abs().max(step[1].abs()).max(step[2].abs() / h);
+        let size = size_of(&step);
         if size <= QUAD_NEWTON_STEP_TOL {
             return Newton::Converged { xi, t };
         }
         if size < 1e-3 {
-            // the bound on the next step, through squares
-            let (a2, b2) = (ja.norm_squared(), jb.norm_squared());
-            let gain2 = bc.norm_squared().max(a2).max(a2 * b2 / (h * h));
-            let s12 = step[0] * step[1];
-            if c12_2 * s12 * s12 * gain2 <= next_tol2 * det * det {
-                return Newton::Converged { xi, t };
+            let v = Vector3::new(q.c12.dot(&bc) * inv, ja.dot(&q.c12.cross(&c)) * inv, ja.dot(&jb.cross(&q.c12)) * inv);
+            let (mut d1, mut d2) = (step[0], step[1]);
+            let mut rho = step[0] * step[1];
+            for _ in 0..QUAD_CHORD_MAX_STEPS {
+                let s = v * -rho;
+                xi[0] += s[0];
+                xi[1] += s[1];
+                t += s[2];
+                if !ok(xi, t) {
+                    return Newton::Failed { iterations: it + 1, residual: f64::INFINITY };
+                }
+                if size_of(&s) <= QUAD_NEWTON_STEP_TOL {
+                    return Newton::Converged { xi, t };
+                }
+                rho = d2 * s[0] + d1 * s[1] + s[0] * s[1];
+                d1 += s[0];
+                d2 += s[1];
             }
         }
     }
@@ -465,17 +496,10 @@ fn project_quad_with(
     if !all_finite(&nodes) || !all_finite(&[*xs, *n]) {
         return Ok(None);
     }
-    let Some(n) = n.try_normalize(0.0) else { return Ok(None) };
+    let Some(n) = unit(n) else { return Ok(None) };
     let h = face_size(&nodes);
     let m = (nodes[2] - nodes[0]).cross(&(nodes[3] - nodes[1])); // centre normal (diagonals)
-    let m_norm = m.norm();
-    if m_norm.is_nan() || m_norm <= 1e-14 * h * h {
-        return Ok(None); // degenerate quad
-    }
-    let cos = n.dot(&m) / m_norm;
-    if cos.abs() < PARALLEL_COS {
-        return Ok(None);
-    }
+    let Some(cos_sign) = facing_sign(&n, &m, h) else { return Ok(None) };
     let q = Bilinear::new(&nodes);
     let xi = match quad_local_newton(&q, xs, &n, h, max_newton, xi0) {
         Newton::Converged { xi, .. } => xi,
@@ -500,7 +524,7 @@ fn project_quad_with(
     };
     let point = q.at(xi);
     let t = n.dot(&(point - xs));
-    let location = match inside_outside(&nodes, &n, &point, cos.signum(), h, tol) {
+    let location = match inside_outside(&nodes, &n, &point, cos_sign, h, tol) {
         Some(l) => l,
         None => return Ok(None),
     };
