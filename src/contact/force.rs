@@ -718,19 +718,7 @@ impl ContactSolver<'_> {
     /// Warm start (each active pair's force of the last step applied to the prediction),
     /// colour order and the Gauss–Seidel lists of moving nodes.
     #[inline(never)]
-    fn prepare_sweeps_into(&mut self, u_next: &mut [f64], dt2: f64) {
-        // the warm-start forces act on the prediction before the first sweep
-        for a in &self.active {
-            if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
-                let [n, t1, t2] = a.frame;
-                let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                let weights = [a.coef[1], a.coef[2], a.coef[3], a.coef[4]];
-                add_pair_force_into(u_next, &self.inv_mass, dt2, a.nodes[0], &a.nodes[1..a.nm as usize + 1], &weights, &r);
-            }
-        }
-        if self.gs_colored {
-            self.order_by_color();
-        }
+    fn prepare_sweeps_into(&mut self, u_next: &mut [f64]) {
         // every moving node of an active pair counts as moved at tick 1, every pair as last
         // evaluated at tick 0: the first sweep evaluates all
         if self.step_clock == u32::MAX {
@@ -740,6 +728,20 @@ impl ContactSolver<'_> {
         self.step_clock += 1;
         self.gs_nodes.clear();
         for a in &self.active {
+            // the warm-start force acts on the prediction before the first sweep (through the
+            // pair's mobilities, as a sweep's update does)
+            if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
+                let [n, t1, t2] = a.frame;
+                let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
+                for b in 0..5 {
+                    let nd = a.nodes[b] as usize;
+                    let du = r * a.mob[b];
+                    let v = &mut u_next[3 * nd..3 * nd + 3];
+                    v[0] += du[0];
+                    v[1] += du[1];
+                    v[2] += du[2];
+                }
+            }
             for &nd in &a.nodes[..a.nm as usize + 1] {
                 if self.inv_mass[nd as usize] > 0.0 {
                     let ns = &mut self.node[nd as usize];
@@ -750,6 +752,9 @@ impl ContactSolver<'_> {
                     }
                 }
             }
+        }
+        if self.gs_colored {
+            self.order_by_color();
         }
         self.sweep_start.resize(self.gs_nodes.len(), Vector3::zeros());
         self.evaluated_at.clear();
@@ -886,7 +891,7 @@ impl Correction for ContactSolver<'_> {
         let t_search = now_if(timed);
         let penalty_work = self.search_into(model, history, dt2, u_prev, u, u_next);
         let t_prepare = now_if(timed);
-        self.prepare_sweeps_into(u_next, dt2);
+        self.prepare_sweeps_into(u_next);
         let t_sweeps = now_if(timed);
         let (sweeps, converged) = self.sweep_into(u_next);
         let t_record = now_if(timed);
