@@ -327,7 +327,10 @@ fn quad_local_newton(q: &Bilinear, xs: &Vector3<f64>, n: &Vector3<f64>, h: f64, 
     let mut t = n.dot(&p0);
     let mut f = p0 - n * t;
     let residual = |xi: [f64; 2], t: f64| q.at(xi) - xs - n * t;
-    let size_of = |s: &Vector3<f64>| s[0].abs().max(s[1].abs()).max(s[2].abs() * inv_h);
+    // the step measure, max by comparison (`f64::max`'s NaN handling was a tenth of a projection;
+    // a non-finite step is caught by `ok` before its size is taken)
+    let max = |a: f64, b: f64| if a > b { a } else { b };
+    let size_of = |s: &Vector3<f64>| max(max(s[0].abs(), s[1].abs()), s[2].abs() * inv_h);
     let ok = |xi: [f64; 2], t: f64| xi[0].abs() < 1e6 && xi[1].abs() < 1e6 && t.is_finite();
     let c = -n;
     for it in 0..max_iter {
