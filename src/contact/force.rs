@@ -341,8 +341,7 @@ impl<'m> ContactSolver<'m> {
 
 #[inline]
 fn pos(model: &Model, u: &[f64], n: usize) -> Vector3<f64> {
-    let x = model.mesh.nodes[n];
-    Vector3::new(x[0] + u[3 * n], x[1] + u[3 * n + 1], x[2] + u[3 * n + 2])
+    Vector3::from(model.mesh.nodes[n]) + disp(u, n)
 }
 
 #[inline]
