@@ -337,7 +337,9 @@ pub fn penalty_force(
         let state = if bonded { PairState::Bonded } else { PairState::Stick };
         return PairResponse { r_n, r_t: r_trial, state, hist: *hist, slip_increment: dd_t };
     }
-    let intact = hist.intact && (law.keep_cohesion || (law.softening_slip > 0.0 && hist.slip + dd_t.norm() < law.softening_slip));
+    // as in `pair_force`: a slip within round-off (`open_tolerance`) does not break the bond
+    let d = dd_t.norm();
+    let intact = hist.intact && (law.keep_cohesion || !law.breaks_by_slip(d, hist.slip + d));
     if hist.intact && !intact && r_n < 0.0 {
         return PairResponse::open(PairHistory { intact, ..*hist }, dd_t);
     }
@@ -531,6 +533,27 @@ mod tests {
         assert!(p.hist.intact, "an exactly touching penalty pair keeps its bond");
         let p = penalty_force(&l, &PairHistory::default(), 2e-12, Vector2::zeros(), Vector2::zeros(), 1e9, 1e9, AREA);
         assert!(!p.hist.intact);
+    }
+
+    #[test]
+    fn penalty_slip_within_open_tolerance_keeps_the_bond() {
+        // Regression: with softening_slip = 0 the penalty law broke the bond at any slip, while
+        // its doc (and `pair_force`) break it only beyond `open_tolerance`. A penalty pair in
+        // compression driven past its limit (r_t_prev = 1e6 N against μ r_n + c A ≈ 2.5e4 N)
+        // slips; a slip increment of 5e-16 m (round-off) keeps the bond, 2e-12 m breaks it.
+        let l = JointLaw { open_tolerance: 1e-12, ..law(0.5, 1e5, 0.0) };
+        let (g, r_prev) = (-1e-6, Vector2::new(1e6, 0.0));
+        let p = penalty_force(&l, &PairHistory::default(), g, r_prev, Vector2::new(5e-16, 0.0), 1e9, 1e9, AREA);
+        assert_eq!((p.state, p.hist.intact), (PairState::Slip, true));
+        let p = penalty_force(&l, &PairHistory::default(), g, r_prev, Vector2::new(2e-12, 0.0), 1e9, 1e9, AREA);
+        assert_eq!((p.state, p.hist.intact), (PairState::Slip, false));
+        // the same decision as the dynamic contact force's law on the same slip increments
+        // (trial gap for r_n = 1e3 N; trial tangential increment k limit + d, so that the slip
+        // increment is d)
+        let k = DT2W;
+        let limit = 0.5 * 1e3 + 1e5 * AREA;
+        let slip_by = |d: f64| pair_force(&l, &PairHistory::default(), -1e3 * k, Vector2::new(-(k * limit + d), 0.0), k, AREA);
+        assert!(slip_by(5e-16).hist.intact && !slip_by(2e-12).hist.intact);
     }
 
     #[test]
