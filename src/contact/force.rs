@@ -854,7 +854,7 @@ impl ContactSolver<'_> {
     /// Write the active pairs' results into the history and return the contact work of the
     /// step [J].
     #[inline(never)]
-    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, u_prev: &[f64], u: &[f64], u_next: &[f64]) -> f64 {
+    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, u_prev: &[f64]) -> f64 {
         let mut work = 0.0;
         for rec in history.joints.iter_mut() {
             rec.sweeps = sweeps;
@@ -866,27 +866,29 @@ impl ContactSolver<'_> {
         for a in &self.active {
             let i = a.pair as usize;
             let [n, t1, t2] = a.frame;
-            let s = a.nodes[0] as usize;
             let p = &mut history.joints[a.joint as usize].pairs[i];
             p.hist = a.hist;
             p.state = a.state;
             p.gap = a.gap;
             p.r_n = a.r_n;
             p.r_t = [a.r_t.x, a.r_t.y];
-            // accumulated tangential relative displacement (final positions)
-            let mut dum = Vector3::zeros();
-            let mut duc = Vector3::zeros();
-            for b in 0..a.nm as usize {
-                let mi = a.nodes[b + 1] as usize;
-                dum += (disp(u_next, mi) - disp(u, mi)) * a.coef[b + 1];
-                duc += (disp(u_next, mi) - disp(u_prev, mi)) * (0.5 * a.coef[b + 1]);
+            // accumulated tangential relative displacement over the step, from the final
+            // positions (the sweeps' local copies) and the relative displacement at t[n]:
+            // Δd = Δu_s − Σ N_I Δu_I = rel_u − Σ coef_b x_b
+            let mut rel = Vector3::zeros();
+            let mut rel_prev = Vector3::zeros();
+            for b in 0..5 {
+                rel += self.local[a.local[b] as usize].x * a.coef[b];
+                rel_prev += disp(u_prev, a.nodes[b] as usize) * a.coef[b];
             }
-            let dd = (disp(u_next, s) - disp(u, s)) - dum;
+            let dd = a.rel_u - rel;
             p.d_t[0] += dd.dot(&t1);
             p.d_t[1] += dd.dot(&t2);
             p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
+            // work of the pair force over the step, on the central-difference increment
+            // ½ (x[n+1] − x[n−1]) of the slave relative to the master point
             let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-            let du = (disp(u_next, s) - disp(u_prev, s)) * 0.5 - duc;
+            let du = (rel_prev - rel) * 0.5;
             work += rvec.dot(&du);
         }
         work
@@ -914,7 +916,7 @@ impl Correction for ContactSolver<'_> {
         let t_sweeps = now_if(timed);
         let (sweeps, converged) = self.sweep_into(u_next);
         let t_record = now_if(timed);
-        let work = penalty_work + self.record_into(history, sweeps, converged, u_prev, u, u_next);
+        let work = penalty_work + self.record_into(history, sweeps, converged, u_prev);
         if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {
             t.search += b - a;
             t.prepare += c - b;
