@@ -646,10 +646,16 @@ impl ContactSolver<'_> {
                                 }
                                 rec.events.fresh_searches += 1;
                                 rec.pairs[i].center = c as u32;
-                                self.candidates_into(j, c as u32, 2);
-                                let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
-                                self.cand = cand;
+                                // Layer2 around the new centre; around the old one it was just
+                                // tried (above, or as the joint's own layer), with the same
+                                // result: a node that stays lost (outside the master, next to
+                                // its edge) costs one Layer2 search a step, not two
+                                if c != pr.center as usize {
+                                    self.candidates_into(j, c as u32, 2);
+                                    let cand = std::mem::take(&mut self.cand);
+                                    found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
+                                    self.cand = cand;
+                                }
                             }
                         }
                         match found {
