@@ -494,7 +494,7 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
 /// the nodes each update moves; without, every pair and no clocks. Returns how many pairs moved
 /// a node by more than the marking tolerance (counted without `LISTED` only). Two copies of the
 /// loop rather than a test per pair, so that the full pass carries nothing of the list.
-#[inline(always)]
+#[inline(never)] // its own code, whatever the code around it (a sweep is long; one call per sweep)
 #[allow(clippy::too_many_arguments)]
 fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64) -> usize {
     let mut moving = 0;
