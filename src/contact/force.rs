@@ -138,7 +138,8 @@ struct NodeScratch {
 /// The work list, as clocks: each pair update ticks the clock; `moved_at` is the tick at which
 /// the node was last moved (by more than the marking tolerance), and a pair's `evaluated_at` the
 /// tick of its last evaluation. A sweep evaluates only the pairs one of whose nodes moved since
-/// their own last evaluation (first sweep: all): a pair whose nodes did not change would give
+/// their own last evaluation (in the sweep that starts the list, all: every node is stamped
+/// then, every pair's tick is still 0): a pair whose nodes did not change would give
 /// the same force, so skipping it is exact. Pairs later in the order are taken in the same
 /// sweep, earlier ones in the next. (Reading five clocks per pair is cheaper than marking every
 /// pair on a moved node, which an earlier bit set with per-node lists did.)
@@ -184,6 +185,28 @@ struct Active {
     mob2_max: f64,
     /// The same five nodes as indices into the solver's local nodes ([`LocalNode`]).
     local: [u32; 5],
+}
+
+impl Active {
+    /// The pair's relative displacement Σ N_I x_I − x_s over the local nodes (five terms
+    /// always: unused entries have coefficient 0).
+    #[inline(always)]
+    fn relative_displacement(&self, local: &[LocalNode]) -> Vector3<f64> {
+        let mut rel = Vector3::zeros();
+        for b in 0..5 {
+            rel += local[self.local[b] as usize].x * self.coef[b];
+        }
+        rel
+    }
+
+    /// Move the pair's local nodes by the displacements a pair force `r` (N, on the slave) makes
+    /// over one step (`mob`: 0 at a fixed node or an unused entry).
+    #[inline(always)]
+    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>) {
+        for b in 0..5 {
+            local[self.local[b] as usize].x += r * self.mob[b];
+        }
+    }
 }
 
 /// Wall time spent in the parts of the contact correction, summed over the steps since it was
@@ -354,6 +377,18 @@ fn disp(u: &[f64], n: usize) -> Vector3<f64> {
     Vector3::new(v[0], v[1], v[2])
 }
 
+/// The positions at `u` of master face `f`'s nodes (Gmsh order; entries past its node count are
+/// zero) and that count.
+#[inline]
+fn face_positions(model: &Model, j: &ContactJoint, f: usize, u: &[f64]) -> ([Vector3<f64>; 4], usize) {
+    let nodes = j.tag.master.faces[f].nodes();
+    let mut x = [Vector3::zeros(); 4];
+    for (a, &nd) in nodes.iter().enumerate() {
+        x[a] = pos(model, u, nd as usize);
+    }
+    (x, nodes.len())
+}
+
 /// Project on one master face `f` (the face of the last step, or a candidate set of one): no
 /// candidate buffer, no selection, and a quad's Newton starts from the node's local coordinates
 /// of the last step (`xi0`). Also returns the squared length of the face's first edge (the
@@ -370,13 +405,9 @@ fn project_on_face(
     tol: f64,
     xi0: [f64; 2],
 ) -> Option<(super::query::Projection, f64)> {
-    let nodes = j.tag.master.faces[f].nodes();
-    let mut x = [Vector3::zeros(); 4];
-    for (a, &nd) in nodes.iter().enumerate() {
-        x[a] = pos(model, u, nd as usize);
-    }
+    let (x, k) = face_positions(model, j, f, u);
     let edge2 = (x[1] - x[0]).norm_squared();
-    let p = match nodes.len() {
+    let p = match k {
         3 => project_along_on_tri(xs, n, [&x[0], &x[1], &x[2]], tol),
         4 => match project_along_on_quad_from(xs, n, [&x[0], &x[1], &x[2], &x[3]], tol, xi0) {
             Ok(p) => p,
@@ -405,7 +436,6 @@ fn project_on(
     tol: f64,
     xi0: [f64; 2],
 ) -> Option<(usize, super::query::Projection)> {
-    let m = &j.tag.master;
     if let [f] = faces {
         return project_on_face(model, j, *f as usize, xs, n, u, failures, tol, xi0).map(|(p, _)| (*f as usize, p));
     }
@@ -415,19 +445,14 @@ fn project_on(
     let mut heap: Vec<(usize, [Vector3<f64>; 4], usize)> = Vec::new();
     let mut count = 0;
     for &f in faces {
-        let face = &m.faces[f as usize];
-        let nodes = face.nodes();
-        let mut x = [Vector3::zeros(); 4];
-        for (a, &nd) in nodes.iter().enumerate() {
-            x[a] = pos(model, u, nd as usize);
-        }
+        let (x, k) = face_positions(model, j, f as usize, u);
         if count < stack.len() {
-            stack[count] = (f as usize, x, nodes.len());
+            stack[count] = (f as usize, x, k);
         } else {
             if heap.is_empty() {
                 heap.extend_from_slice(&stack);
             }
-            heap.push((f as usize, x, nodes.len()));
+            heap.push((f as usize, x, k));
         }
         count += 1;
     }
@@ -509,12 +534,8 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
             evaluated_at[k] = *clock;
         }
         let [n, t1, t2] = a.frame;
-        // current relative quantities with all forces applied so far (five nodes
-        // always: unused entries repeat the slave with coefficient and mobility 0)
-        let mut rel = Vector3::zeros();
-        for b in 0..5 {
-            rel += local[a.local[b] as usize].x * a.coef[b];
-        }
+        // current relative quantities with all forces applied so far
+        let rel = a.relative_displacement(local);
         let g_cur = a.gap0 + n.dot(&rel);
         let dd = a.rel_u - rel;
         // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
@@ -538,9 +559,7 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
             }
         } else {
             moving += (dr2 * a.mob2_max > mark_tol2) as usize;
-            for b in 0..5 {
-                local[a.local[b] as usize].x += dr * a.mob[b];
-            }
+            a.move_nodes_into(local, &dr);
         }
         let e = &mut active[k];
         e.gap = g_trial + e.dt2w * resp.r_n;
@@ -807,8 +826,6 @@ impl ContactSolver<'_> {
     /// colour order and the Gauss–Seidel lists of moving nodes.
     #[inline(never)]
     fn prepare_sweeps_into(&mut self, u_next: &mut [f64]) {
-        // every moving node of an active pair counts as moved at tick 1, every pair as last
-        // evaluated at tick 0: the first sweep evaluates all
         if self.step_clock == u32::MAX {
             self.node.iter_mut().for_each(|ns| ns.listed = 0);
             self.step_clock = 0;
@@ -816,7 +833,7 @@ impl ContactSolver<'_> {
         self.step_clock += 1;
         self.local.clear();
         self.local_global.clear();
-        let ContactSolver { active, node, local, local_global, inv_mass, step_clock, .. } = self;
+        let ContactSolver { active, node, local, local_global, step_clock, .. } = self;
         for a in active.iter_mut() {
             // the pair's nodes among the local nodes, copied from the prediction when first met
             for b in 0..5 {
@@ -825,7 +842,8 @@ impl ContactSolver<'_> {
                 if ns.listed != *step_clock {
                     ns.listed = *step_clock;
                     ns.local = local.len() as u32;
-                    local.push(LocalNode { x: disp(u_next, nd), moved_at: (inv_mass[nd] > 0.0) as u32 });
+                    // clock 0: the sweeps stamp every node when they start the work list
+                    local.push(LocalNode { x: disp(u_next, nd), moved_at: 0 });
                     local_global.push(nd as u32);
                 }
                 a.local[b] = ns.local;
@@ -835,9 +853,7 @@ impl ContactSolver<'_> {
             if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
                 let [n, t1, t2] = a.frame;
                 let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                for b in 0..5 {
-                    local[a.local[b] as usize].x += r * a.mob[b];
-                }
+                a.move_nodes_into(local, &r);
             }
         }
         if self.gs_colored {
@@ -926,10 +942,9 @@ impl ContactSolver<'_> {
             // accumulated tangential relative displacement over the step, from the final
             // positions (the sweeps' local copies) and the relative displacement at t[n]:
             // Δd = Δu_s − Σ N_I Δu_I = rel_u − Σ coef_b x_b
-            let mut rel = Vector3::zeros();
+            let rel = a.relative_displacement(&self.local);
             let mut rel_prev = Vector3::zeros();
             for b in 0..5 {
-                rel += self.local[a.local[b] as usize].x * a.coef[b];
                 rel_prev += disp(u_prev, a.nodes[b] as usize) * a.coef[b];
             }
             let dd = a.rel_u - rel;

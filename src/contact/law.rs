@@ -114,6 +114,16 @@ pub struct JointLawError {
 }
 
 impl JointLaw {
+    /// The Mohr-Coulomb limit of the tangential force (N) under normal force `r_n` (N,
+    /// compressive): μ r_n + the cohesive force, not below 0. The floor by comparison:
+    /// `f64::max`'s NaN handling cost a thirtieth of a Gauss–Seidel sweep; a NaN limit gives 0
+    /// either way. One definition for the dynamic contact force and the penalty springs.
+    #[inline(always)]
+    pub fn shear_limit(&self, r_n: f64, hist: &PairHistory, area: f64) -> f64 {
+        let limit = self.mu * r_n + self.cohesion_force(hist, area);
+        if limit > 0.0 { limit } else { 0.0 }
+    }
+
     /// The cohesive force of a pair (N): c A while intact, softened linearly with the
     /// accumulated slip over [`JointLaw::softening_slip`]; 0 once the bond is lost.
     pub fn cohesion_force(&self, hist: &PairHistory, area: f64) -> f64 {
@@ -262,10 +272,7 @@ pub fn pair_force_with_inverse(
         return PairResponse::open(PairHistory { intact: false, ..*hist }, dt_trial);
     }
     let r_trial = -dt_trial * inv_k;
-    // the limit, not below 0 (by comparison: `f64::max`'s NaN handling cost a thirtieth of a
-    // Gauss–Seidel sweep; a NaN limit gives 0 either way)
-    let limit = law.mu * r_n + law.cohesion_force(hist, area);
-    let limit = if limit > 0.0 { limit } else { 0.0 };
+    let limit = law.shear_limit(r_n, hist, area);
     // stick when |r_trial| ≤ limit, compared through the squares (no root when it sticks)
     if r_trial.norm_squared() <= limit * limit {
         let state = if bonded { PairState::Bonded } else { PairState::Stick };
@@ -330,10 +337,7 @@ pub fn penalty_force(
     if r_n < -law.tensile_strength * area {
         return PairResponse::open(PairHistory { intact: false, ..*hist }, dd_t);
     }
-    // the limit, not below 0 (by comparison: `f64::max`'s NaN handling cost a thirtieth of a
-    // Gauss–Seidel sweep; a NaN limit gives 0 either way)
-    let limit = law.mu * r_n + law.cohesion_force(hist, area);
-    let limit = if limit > 0.0 { limit } else { 0.0 };
+    let limit = law.shear_limit(r_n, hist, area);
     let r_trial_norm = r_trial.norm();
     if r_trial_norm <= limit {
         let state = if bonded { PairState::Bonded } else { PairState::Stick };

@@ -479,8 +479,8 @@ pub fn project_along_on_quad(
 }
 
 /// [`project_along_on_quad`] with Newton started from `xi0` instead of the centre: a node that
-/// stays on its face starts from its local coordinates of the last step and converges in about
-/// two iterations instead of four. The same equations and the same root (to the Newton
+/// stays on its face starts from its local coordinates of the last step and converges in one
+/// Newton solve and one or two chord steps instead of four solves. The same equations and the same root (to the Newton
 /// tolerance); a start that is not finite or far outside the face (|ξ| > 2) falls back to the
 /// centre.
 pub fn project_along_on_quad_from(
