@@ -424,7 +424,9 @@ fn project_on_face(
     p.map(|p| (p, edge2))
 }
 
-/// Project slave node `i` of joint `j` on the master faces `faces` at the positions `u`.
+/// Project slave node `i` of joint `j` on the master faces `faces` at the positions `u` (a
+/// quad's Newton from its centre).
+#[allow(clippy::too_many_arguments)]
 fn project_on(
     model: &Model,
     j: &ContactJoint,
@@ -434,10 +436,9 @@ fn project_on(
     u: &[f64],
     failures: &mut u64,
     tol: f64,
-    xi0: [f64; 2],
 ) -> Option<(usize, super::query::Projection)> {
     if let [f] = faces {
-        return project_on_face(model, j, *f as usize, xs, n, u, failures, tol, xi0).map(|(p, _)| (*f as usize, p));
+        return project_on_face(model, j, *f as usize, xs, n, u, failures, tol, [0.0, 0.0]).map(|(p, _)| (*f as usize, p));
     }
     // candidate sets are small (Layer2 of a structured quad mesh: 16 faces); the stack buffer
     // avoids an allocation per node and step, larger sets fall back to the heap
@@ -621,13 +622,13 @@ impl ContactSolver<'_> {
                         if found.is_none() {
                             self.candidates_into(j, pr.center, j.layer);
                             let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
+                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                             self.cand = cand;
                         }
                         if found.is_none() {
                             // a node just off the master's free edge (see `edge_tolerance`)
                             let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance, [0.0, 0.0]);
+                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance);
                             self.cand = cand;
                             if found.is_some() {
                                 rec.events.perimeter_kept += 1;
@@ -637,7 +638,7 @@ impl ContactSolver<'_> {
                             if j.layer < 2 {
                                 self.candidates_into(j, pr.center, 2);
                                 let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
+                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                                 self.cand = cand;
                                 if found.is_some() {
                                     rec.events.widened_layer2 += 1;
@@ -672,7 +673,7 @@ impl ContactSolver<'_> {
                                 if c != pr.center as usize {
                                     self.candidates_into(j, c as u32, 2);
                                     let cand = std::mem::take(&mut self.cand);
-                                    found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, [0.0, 0.0]);
+                                    found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
                                     self.cand = cand;
                                 }
                             }
