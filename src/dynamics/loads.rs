@@ -2,7 +2,8 @@
 //!
 //! Relative form: with the base moving with acceleration a_g(t), the displacements solved for are
 //! relative to the base, fixed boundary nodes have relative displacement 0, and every node with
-//! mass carries the effective force −m a_g(t). Records are already in m/s² ([`super::record`]).
+//! inertia carries the effective force −M a_g(t) (inertial mass, added inertia included);
+//! gravity acts on the gravitational mass (`model::mass`). Records are already in m/s² ([`super::record`]).
 
 use super::record::Record;
 use crate::error::{Error, ModelError};
@@ -144,14 +145,32 @@ impl Loads {
     pub fn external_force_into(&self, model: &Model, t: f64, with_gravity: bool, with_dynamic: bool, f: &mut [f64]) {
         let g = if with_gravity { self.gravity.unwrap_or([0.0; 3]) } else { [0.0; 3] };
         let ag = if with_dynamic { self.ground_acceleration(t) } else { [0.0; 3] };
-        for (n, &m) in model.mass.iter().enumerate() {
+        let mass = &model.mass;
+        for (n, (&m, &mg)) in mass.inertial.iter().zip(&mass.gravitational).enumerate() {
             let w = match &self.gravity_nodes {
                 Some(mask) if !mask[n] => 0.0,
                 _ => 1.0,
             };
-            f[3 * n] = m * (w * g[0] - ag[0]);
-            f[3 * n + 1] = m * (w * g[1] - ag[1]);
-            f[3 * n + 2] = m * (w * g[2] - ag[2]);
+            if m == mg {
+                f[3 * n] = m * (w * g[0] - ag[0]);
+                f[3 * n + 1] = m * (w * g[1] - ag[1]);
+                f[3 * n + 2] = m * (w * g[2] - ag[2]);
+            } else {
+                // weight and inertia apart: m_g g − m a_g
+                f[3 * n] = mg * w * g[0] - m * ag[0];
+                f[3 * n + 1] = mg * w * g[1] - m * ag[1];
+                f[3 * n + 2] = mg * w * g[2] - m * ag[2];
+            }
+        }
+        if with_dynamic && ag != [0.0; 3] {
+            // the added inertia's base force −A a_g (no weight)
+            let agv = Vector3::from(ag);
+            for b in &mass.blocks {
+                let fb = b.added * agv;
+                for c in 0..3 {
+                    f[3 * b.node as usize + c] -= fb[c];
+                }
+            }
         }
         if with_dynamic {
             for p in &self.patterns {

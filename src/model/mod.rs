@@ -1,13 +1,16 @@
 //! The model: built once from the mesh and the scene, never mutated during a run.
 //!
 //! Owns: materials per volume group, element data (tet4 geometry, shared hex8 shapes),
-//! lumped nodal masses, fixed components, and the element colouring used for deterministic
-//! parallel assembly. Inputs: [`Mesh`], scene materials and boundary conditions.
+//! nodal masses ([`mass`]: inertia and weight apart), fixed components, and the element
+//! colouring used for deterministic parallel assembly. Joints are not part of the model: they
+//! are their own stage (`contact::joint::build_joints`), built once from the tagger.
+//! Inputs: [`Mesh`], scene materials and boundary conditions.
 //! Outputs: `K u` ([`Model::internal_forces_into`]), element stresses, the stable step.
 //!
 //! Invariants:
-//! - Degrees of freedom are `3 * node + component` (x, y, z), for every mesh node; nodes with
-//!   no mass (not in any material volume) are inactive and treated as fixed.
+//! - Degrees of freedom are `3 * node + component` (x, y, z), for every mesh node; nodes in no
+//!   material volume are inactive and treated as fixed. Nodes of massless elements (ρ = 0) are
+//!   active but have no inertia: the explicit step leaves them to a constraint ([`Model::held`]).
 //! - Elements are stored in assembly order ([`Schedule`]): sorted along a Morton (Z-order)
 //!   curve of their centroids, cut into chunks of consecutive elements, and the chunks grouped
 //!   by colour. No two chunks of one colour share a node, so the chunks of a colour are
@@ -19,6 +22,7 @@
 //!   M ü + C u̇ + f_int = F_ext + R.
 
 pub mod hex8;
+pub mod mass;
 pub mod material;
 pub mod tet4;
 
@@ -26,6 +30,7 @@ use crate::error::{MeshError, ModelError};
 use crate::mesh::{CellKind, Mesh};
 use crate::scene::Scene;
 use hex8::HexShape;
+use mass::NodalMass;
 use material::{Lame, Material};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -84,10 +89,13 @@ pub struct Model {
     pub materials: Vec<Material>,
     pub tets: Tet4Set,
     pub hexes: Hex8Set,
-    /// Lumped mass per node [kg] (0 = inactive node).
-    pub mass: Vec<f64>,
+    /// Inertial and gravitational mass per node ([`mass`]).
+    pub mass: NodalMass,
     /// Fixed components per node: bit 0 = x, 1 = y, 2 = z. Inactive nodes are fully fixed.
     pub fixed: Vec<u8>,
+    /// Components the explicit step does not integrate (u[n+1] = 0 in the prediction): the fixed
+    /// ones, and all three of a node without inertia (set by a constraint instead).
+    pub held: Vec<u8>,
     /// Rayleigh damping C = αM + βK: α [1/s], β [s].
     pub alpha: f64,
     /// Per node: whether αM applies in the dynamic stage (scene `damping.mass_groups`; all
@@ -95,8 +103,6 @@ pub struct Model {
     pub mass_damped: Vec<bool>,
     pub beta: f64,
     pub critical: CriticalElement,
-    /// Joints (tagged interfaces with their laws), in scene order.
-    pub joints: Vec<crate::contact::joint::ContactJoint>,
 }
 
 /// Scatter target shared across threads. Safe use requires that no two concurrent writers touch
@@ -280,13 +286,6 @@ impl Model {
         // material of every mesh cell (u32::MAX: none)
         let mut owner = vec![u32::MAX; mesh.cells.len()];
         for (mi, ms) in scene.materials.iter().enumerate() {
-            if ms.rho == 0.0 {
-                return Err(ModelError::Invalid(format!(
-                    "material \"{}\": rho = 0 (massless foundation) needs static condensation, which this version does not provide; give the foundation a density",
-                    ms.group
-                ))
-                .into());
-            }
             let g = mesh.group_of_dim(&ms.group, 3)?;
             mesh.check_orientation(g)?;
             for &c in &g.cells {
@@ -313,6 +312,7 @@ impl Model {
         let mut shapes: Vec<HexShape> = Vec::new();
         let mut shape_key: HashMap<(usize, [i64; 21]), u32> = HashMap::new();
         let mut mass = vec![0.0; n];
+        let mut active = vec![false; n];
         let inverted = |c: usize, mi: usize| -> crate::Error {
             MeshError::InvertedElement {
                 path: mesh.source.clone(),
@@ -336,6 +336,7 @@ impl Model {
                     let g = tet4::tet_geometry(&tet_x(cell.nodes())).ok_or_else(|| inverted(c, mi))?;
                     for a in 0..4 {
                         mass[cell.node(a)] += rho * g.vol / 4.0;
+                        active[cell.node(a)] = true;
                     }
                     tn.push(std::array::from_fn(|a| cell.nodes()[a]));
                     tm.push(mi as u16);
@@ -365,6 +366,7 @@ impl Model {
                     let s = &shapes[id as usize];
                     for a in 0..8 {
                         mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
+                        active[cell.node(a)] = true;
                     }
                     hn.push(std::array::from_fn(|a| cell.nodes()[a]));
                     hs.push(id);
@@ -400,7 +402,7 @@ impl Model {
         drop((ho, hn, hs, hm, hc));
 
         // ---- boundary conditions
-        let mut fixed: Vec<u8> = mass.iter().map(|&m| if m > 0.0 { 0 } else { 7 }).collect();
+        let mut fixed: Vec<u8> = active.iter().map(|&a| if a { 0 } else { 7 }).collect();
         for b in &scene.boundary {
             let bits = b.fix.iter().fold(0u8, |acc, c| acc | match c.as_str() { "x" => 1, "y" => 2, _ => 4 });
             for node in mesh.group_nodes(&b.group)? {
@@ -421,34 +423,19 @@ impl Model {
                 d
             }
         };
-        // ---- joints (tagged once on the initial configuration)
-        let size = {
-            let (lo, hi) = mesh.nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(mut lo, mut hi), x| {
-                for i in 0..3 {
-                    lo[i] = lo[i].min(x[i]);
-                    hi[i] = hi[i].max(x[i]);
-                }
-                (lo, hi)
-            });
-            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
-        };
-        let mut joints = Vec::new();
-        for js in &scene.joints {
-            joints.push(crate::contact::joint::ContactJoint::build(&mesh, js, size)?);
-        }
-
+        let held = fixed.iter().zip(&mass).map(|(&f, &m)| if m > 0.0 { f } else { 7 }).collect();
         let mut model = Model {
             mesh,
             materials,
             tets,
             hexes,
-            mass,
+            mass: NodalMass::lumped(mass),
             fixed,
+            held,
             alpha,
             mass_damped,
             beta,
             critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
-            joints,
         };
         model.critical = model.max_element_eigenvalue();
         Ok(model)
@@ -460,6 +447,21 @@ impl Model {
 
     pub fn n_elements(&self) -> usize {
         self.tets.nodes.len() + self.hexes.nodes.len()
+    }
+
+    /// Add the symmetric inertia `a` [kg] (no weight) to `node`, e.g. a reservoir's added mass
+    /// m_a n nᵀ ([`NodalMass::add_inertia`]). The stable step stays that of the elements alone:
+    /// added inertia only lowers the frequencies, so the element bound remains an upper bound.
+    pub fn add_inertia(&mut self, node: usize, a: nalgebra::Matrix3<f64>) {
+        self.mass.add_inertia(node, a, self.fixed[node]);
+        if self.held[node] == 7 && self.fixed[node] != 7 {
+            self.held[node] = self.fixed[node];
+        }
+    }
+
+    /// Diagonal of the size of the mesh's bounding box [m] (0 for an empty mesh).
+    pub fn size(&self) -> f64 {
+        self.mesh.diagonal()
     }
 
     /// Whether dof (node, component) is free.
@@ -476,7 +478,9 @@ impl Model {
             .map(|e| {
                 let m = &self.materials[self.tets.mat[e] as usize];
                 let g = &self.tets.geom[e];
-                (tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame), self.tets.cell[e] as usize, self.tets.mat[e] as usize)
+                // a massless element (ρ = 0) sets no stable step: its nodes are condensed statically
+                let w = if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) } else { 0.0 };
+                (w, self.tets.cell[e] as usize, self.tets.mat[e] as usize)
             })
             .reduce(|| (0.0, 0, 0), |a, b| if b.0 > a.0 || (b.0 == a.0 && b.1 < a.1) { b } else { a });
         // shapes are shared: one eigenvalue per (shape), with the material of its first element
@@ -494,7 +498,7 @@ impl Model {
             .zip(&shape_mat)
             .map(|(s, &mi)| {
                 let m = &self.materials[mi as usize];
-                hex8::max_eigenvalue(s, m.rho, &m.lame)
+                if m.rho > 0.0 { hex8::max_eigenvalue(s, m.rho, &m.lame) } else { 0.0 }
             })
             .collect();
         let mut best = t;
