@@ -33,6 +33,12 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
             if version.is_empty() { "of an unknown version" } else { version }
         )));
     }
+    let fields: Vec<&str> = version_line.split_whitespace().collect();
+    if fields.len() != 3 || !matches!(fields[1], "0" | "1") || fields[2] != "8" {
+        return Err(malformed(format!(
+            "the $MeshFormat line reads `{version_line}`; it must be `4.1 0 8` (ASCII) or `4.1 1 8` (binary)"
+        )));
+    }
     let msh = mshio::parse_msh_bytes(bytes).map_err(|e| {
         let s = e.to_string();
         malformed(s.lines().take(6).collect::<Vec<_>>().join("; "))
