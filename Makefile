@@ -17,7 +17,7 @@ JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures wedge wedge3 wedge-report
+.PHONY: demo test venv build mesh run bench clean fixtures wedge wedge3 wedge-report fuzz
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -105,6 +105,12 @@ bench: build
 	cargo bench --bench explicit
 	cargo bench --bench tagger
 	cargo bench --bench contact
+
+# The fuzz properties of tests/all/fuzz.rs with many more cases than `make test` runs
+# (FUZZ_CASES per property, default 20000; fixed seed, so a failure reproduces).
+FUZZ_CASES ?= 20000
+fuzz:
+	JQ_FUZZ_CASES=$(FUZZ_CASES) cargo test --release --test all fuzz
 
 fixtures: venv
 	GMSH=$(GMSH) scripts/fixtures.sh

@@ -1,6 +1,7 @@
 //! Running the gmsh command line (no shell) and caching its `.msh`.
 //!
-//! Which gmsh: the `GMSH` environment variable (a path to an executable) if set; otherwise the
+//! Which gmsh: the `GMSH` environment variable (a path to an executable, or to the wheel's
+//! `.venv/bin/gmsh` script, which is then run by the `python` beside it) if set; otherwise the
 //! PyPI wheel in a project-local `.venv` (its `bin/gmsh` script run by the venv's python),
 //! looked up from the current directory and from the directory of this executable; otherwise
 //! `gmsh` on the PATH.
@@ -19,7 +20,7 @@ use std::process::Command;
 pub fn gmsh_command() -> Vec<String> {
     if let Ok(g) = std::env::var("GMSH") {
         if !g.trim().is_empty() {
-            return vec![g];
+            return wheel_script_command(Path::new(&g)).unwrap_or_else(|| vec![g]);
         }
     }
     let mut roots = vec![PathBuf::from(".")];
@@ -37,6 +38,20 @@ pub fn gmsh_command() -> Vec<String> {
         }
     }
     vec!["gmsh".into()]
+}
+
+/// `GMSH=.venv/bin/gmsh` names the PyPI wheel's launcher, a Python script whose `#!` line runs
+/// whatever `python` is first on the PATH (which then lacks the gmsh module). Run such a script
+/// with the `python` beside it when there is one (the venv's), as the default lookup does.
+fn wheel_script_command(g: &Path) -> Option<Vec<String>> {
+    let mut head = [0u8; 128];
+    let n = std::io::Read::read(&mut std::fs::File::open(g).ok()?, &mut head).ok()?;
+    let first = head[..n].split(|&b| b == b'\n').next()?;
+    if !(first.starts_with(b"#!") && first.windows(6).any(|w| w == b"python")) {
+        return None;
+    }
+    let py = g.parent()?.join("python");
+    py.exists().then(|| vec![py.to_string_lossy().into_owned(), g.to_string_lossy().into_owned()])
 }
 
 /// Cache key of a `.geo` and its parameters.
@@ -88,4 +103,27 @@ pub fn mesh_geo(geo: &Path, set: &BTreeMap<String, f64>, cache_dir: &Path) -> Re
     }
     std::fs::rename(&tmp, &msh).map_err(|source| GmshError::Io { path: msh.clone(), source })?;
     Ok(msh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gmsh_env_naming_the_wheel_script_runs_it_with_the_venv_python() {
+        // Regression: `GMSH=.venv/bin/gmsh` ran the script's `#!/usr/bin/env python`, i.e. the
+        // PATH's python without the gmsh module (ModuleNotFoundError).
+        let d = std::env::temp_dir().join(format!("jq-gmsh-wheel-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        let script = d.join("gmsh");
+        std::fs::write(&script, "#!/usr/bin/env python\nimport gmsh\n").unwrap();
+        std::fs::write(d.join("python"), "").unwrap();
+        let cmd = wheel_script_command(&script).expect("a python launcher beside its python");
+        assert_eq!(cmd, vec![d.join("python").to_string_lossy().into_owned(), script.to_string_lossy().into_owned()]);
+        // A real executable (not a python script) is run as it is.
+        let exe = d.join("gmsh-bin");
+        std::fs::write(&exe, b"\x7fELF\x02\x01\x01").unwrap();
+        assert!(wheel_script_command(&exe).is_none());
+        let _ = std::fs::remove_dir_all(&d);
+    }
 }

@@ -231,6 +231,7 @@ fn real_main() -> Result<()> {
             }
         }
         Cmd::Run { scene, out, cache, threads, quiet, duration } => {
+            let threads = threads.map(capped_threads).transpose()?;
             if let Some(n) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
             }
@@ -304,6 +305,7 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
             say!("  makefile  {}", files.makefile.display());
         }
         StudyCmd::Ssr { study, cache, threads } => {
+            let threads = threads.map(capped_threads).transpose()?;
             if let Some(n) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
             }
@@ -346,4 +348,17 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `--threads N` within what the machine has: 0 is refused, more than its cores is cut to its
+/// cores with a message (threads beyond them only compete, and an absurd count would try to
+/// spawn them all).
+fn capped_threads(n: usize) -> anyhow::Result<usize> {
+    anyhow::ensure!(n >= 1, "--threads 0: give at least 1 thread (or leave --threads out for the default)");
+    let cores = std::thread::available_parallelism().map(|c| c.get()).unwrap_or(1);
+    if n > cores {
+        eprintln!("note: --threads {n}: this machine has {cores} cores; using {cores}");
+        return Ok(cores);
+    }
+    Ok(n)
 }

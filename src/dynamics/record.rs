@@ -24,12 +24,25 @@ pub struct Record {
 /// Relative tolerance on uneven time steps.
 const UNEVEN_TOL: f64 = 1e-6;
 
+/// Smallest sample interval accepted [s]. Default 1e-7 s (10 MHz): accelerographs sample at
+/// 50–1000 Hz, so a smaller step means times not in seconds (or a corrupt file), and it would
+/// make a run take an unbounded number of steps.
+pub const MIN_RECORD_DT: f64 = 1e-7;
+
 impl Record {
     /// Read a record in g and convert to m/s² with `g` [m/s²].
     pub fn read(path: &Path, g: f64) -> Result<Record, RecordError> {
         let text = std::fs::read_to_string(path).map_err(|source| RecordError::Io { path: path.to_path_buf(), source })?;
+        // A UTF-8 byte-order mark (spreadsheets on Windows write one) is not part of the data.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let is_at2 = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("at2"));
-        let mut r = if is_at2 { parse_at2(&text, path)? } else { parse_two_column(&text, path)? };
+        let mut r = if is_at2 { parse_at2(text, path)? } else { parse_two_column(text, path)? };
+        if !(r.dt >= MIN_RECORD_DT && r.dt.is_finite()) {
+            return Err(RecordError::Invalid {
+                path: path.to_path_buf(),
+                message: format!("sample interval {:e} s is below {MIN_RECORD_DT:e} s: times must be in seconds (accelerographs sample at 50–1000 Hz)", r.dt),
+            });
+        }
         for a in &mut r.accel {
             *a *= g;
         }
@@ -49,7 +62,8 @@ impl Record {
     /// Acceleration [m/s²] at time t, linearly interpolated; 0 outside the record.
     pub fn at(&self, t: f64) -> f64 {
         let s = (t - self.t0) / self.dt;
-        if s < 0.0 || self.accel.is_empty() {
+        // Also outside: NaN, and any s too large for an index (the cast below saturates).
+        if !(s >= 0.0 && s < self.accel.len() as f64) {
             return 0.0;
         }
         let i = s.floor() as usize;
@@ -78,6 +92,13 @@ fn parse_two_column(text: &str, path: &Path) -> Result<Record, RecordError> {
         let (Some(ts), Some(as_)) = (it.next(), it.next()) else {
             return Err(line_err(path, k + 1, format!("expected two columns (t [s], a [g]), found `{l}`")));
         };
+        if let Some(extra) = it.next() {
+            return Err(line_err(
+                path,
+                k + 1,
+                format!("expected two columns (t [s], a [g]), found a third (`{extra}`) in `{l}`. A record file holds one component: split a multi-component file into one file per component and give each its own `loads.base` entry with its `direction`."),
+            ));
+        }
         let tv: f64 = ts.parse().map_err(|_| line_err(path, k + 1, format!("time `{ts}` is not a number")))?;
         let av: f64 = as_.parse().map_err(|_| line_err(path, k + 1, format!("acceleration `{as_}` is not a number")))?;
         if !tv.is_finite() || !av.is_finite() {
@@ -115,8 +136,11 @@ fn parse_two_column(text: &str, path: &Path) -> Result<Record, RecordError> {
 
 fn parse_at2(text: &str, path: &Path) -> Result<Record, RecordError> {
     let lines: Vec<&str> = text.lines().collect();
-    if lines.len() < 5 {
-        return Err(RecordError::Invalid { path: path.to_path_buf(), message: "an AT2 file has 4 header lines".into() });
+    if lines.len() < 4 {
+        return Err(RecordError::Invalid {
+            path: path.to_path_buf(),
+            message: format!("it has {} lines: an AT2 file has 4 header lines (NPTS and DT on the 4th), then the values", lines.len()),
+        });
     }
     let h = lines[3].to_ascii_uppercase();
     let field = |key: &str| -> Option<f64> {
@@ -136,6 +160,11 @@ fn parse_at2(text: &str, path: &Path) -> Result<Record, RecordError> {
     };
     if !(npts >= 1.0 && npts.fract() == 0.0) {
         return Err(line_err(path, 4, format!("NPTS = {npts} must be a positive whole number")));
+    }
+    // Every value takes at least two bytes (a digit and a separator): a count beyond that cannot
+    // be right, and must not size an allocation.
+    if npts > (text.len() / 2 + 1) as f64 {
+        return Err(line_err(path, 4, format!("NPTS = {npts} is more values than a file of {} bytes can hold", text.len())));
     }
     let npts = npts as usize;
     if !(dt > 0.0 && dt.is_finite()) {

@@ -19,8 +19,25 @@ pub(super) fn read_msh(path: PathBuf) -> Result<Mesh, MeshError> {
 /// Parse a MSH 4.1 file held in memory; `path` is only used in messages.
 pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
     let malformed = |reason: String| MeshError::Malformed { path: path.clone(), reason };
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes); // a UTF-8 byte-order mark
     if !bytes.starts_with(b"$MeshFormat") {
         return Err(malformed("it does not start with $MeshFormat".into()));
+    }
+    // The version before mshio sees the file, so that MSH 2.2 or 4.0 gets a clear message
+    // instead of a parser dump.
+    let version_line = bytes[b"$MeshFormat".len()..].split(|&b| b == b'\n').map(|l| String::from_utf8_lossy(l).trim().to_string()).find(|l| !l.is_empty()).unwrap_or_default();
+    let version = version_line.split_whitespace().next().unwrap_or("");
+    if version != "4.1" {
+        return Err(malformed(format!(
+            "this is MSH {} (the $MeshFormat line reads `{version_line}`); jointquake reads MSH 4.1: re-export it with `gmsh FILE -save -format msh41` or Gmsh's File > Export, version 4.1",
+            if version.is_empty() { "of an unknown version" } else { version }
+        )));
+    }
+    let fields: Vec<&str> = version_line.split_whitespace().collect();
+    if fields.len() != 3 || !matches!(fields[1], "0" | "1") || fields[2] != "8" {
+        return Err(malformed(format!(
+            "the $MeshFormat line reads `{version_line}`; it must be `4.1 0 8` (ASCII) or `4.1 1 8` (binary)"
+        )));
     }
     let msh = mshio::parse_msh_bytes(bytes).map_err(|e| {
         let s = e.to_string();
@@ -33,8 +50,13 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
 
     // ---- nodes
     let nodes_sec = msh.data.nodes.as_ref().ok_or_else(|| malformed("no $Nodes section".into()))?;
-    let mut nodes = Vec::with_capacity(nodes_sec.num_nodes as usize);
-    let mut node_tags = Vec::with_capacity(nodes_sec.num_nodes as usize);
+    // Capacities from what was parsed, never from a count the file claims.
+    let n_parsed: usize = nodes_sec.node_blocks.iter().map(|b| b.nodes.len()).sum();
+    if nodes_sec.num_nodes as u128 != n_parsed as u128 {
+        return Err(malformed(format!("the $Nodes header claims {} nodes but its blocks hold {n_parsed}", nodes_sec.num_nodes)));
+    }
+    let mut nodes = Vec::with_capacity(n_parsed);
+    let mut node_tags = Vec::with_capacity(n_parsed);
     let file_tags = if nodes_sec.node_blocks.iter().any(|b| b.node_tags.is_none()) {
         let tags = node_tags_in_file_order(bytes, &msh.header).map_err(malformed)?;
         let n: usize = nodes_sec.node_blocks.iter().map(|b| b.nodes.len()).sum();
@@ -91,6 +113,10 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
 
     // ---- elements
     let elems = msh.data.elements.as_ref().ok_or_else(|| malformed("no $Elements section".into()))?;
+    let e_parsed: usize = elems.element_blocks.iter().map(|b| b.elements.len()).sum();
+    if elems.num_elements as u128 != e_parsed as u128 {
+        return Err(malformed(format!("the $Elements header claims {} elements but its blocks hold {e_parsed}", elems.num_elements)));
+    }
     let mut cells = Vec::new();
     let mut groups: BTreeMap<(usize, i32), Vec<usize>> = BTreeMap::new();
     let mut local = Vec::with_capacity(8);

@@ -331,3 +331,104 @@ fn unsupported_element_type_is_named() {
     let msg = run_error("prism_run", &s);
     assert_mentions(&msg, &["prism.msh", "element 7", "unsupported type", "tet4 and hex8"]);
 }
+
+// ---- issue 19 §3: crashers and misleading messages from record and mesh files.
+// Each test is named after the bug it guards against.
+
+/// Read a record file directly (no scene); the error text, or the record.
+fn read_record(test: &str, file: &str, text: &[u8]) -> Result<jointquake::dynamics::record::Record, String> {
+    let dir = scratch(&format!("bad_input/{test}"));
+    let p = dir.join(file);
+    std::fs::write(&p, text).unwrap();
+    jointquake::dynamics::record::Record::read(&p, 9.81).map_err(|e| e.to_string())
+}
+
+#[test]
+fn record_with_dt_1e_300_is_refused_instead_of_panicking_at_index() {
+    // Before: dt 1e-300 read, then `Record::at` indexed out of bounds (the saturated cast).
+    let (msg, rec) = record_error("tiny_dt_record", "0 0\n1e-300 0.1\n2e-300 0\n");
+    assert_mentions(&msg, &[&rec.display().to_string(), "sample interval", "seconds"]);
+}
+
+#[test]
+fn record_at_far_beyond_its_end_is_zero_not_a_panic() {
+    // The interpolation guards its own index: a time 1e300 record-steps past the end reads 0.
+    let r = read_record("record_at_far", "r.txt", b"0 1\n0.01 1\n0.02 1\n").unwrap();
+    assert_eq!(r.at(1e300), 0.0);
+    assert_eq!(r.at(f64::NAN), 0.0);
+    assert_eq!(r.at(-1.0), 0.0);
+    assert!((r.at(0.015) - 9.81).abs() < 1e-12);
+}
+
+#[test]
+fn at2_with_npts_1e15_is_an_error_not_an_allocation_abort() {
+    let msg = read_record("at2_npts_huge", "r.AT2", b"h1\nh2\nh3\nNPTS= 1000000000000000, DT= 0.01 SEC\n0.1 0.2\n").unwrap_err();
+    assert_mentions(&msg, &["line 4", "NPTS", "more values than a file of"]);
+}
+
+#[test]
+fn at2_with_npts_2_pow_64_is_an_error_not_a_capacity_overflow() {
+    let msg = read_record("at2_npts_u64", "r.AT2", b"h1\nh2\nh3\nNPTS= 18446744073709551615, DT= 0.01 SEC\n0.1 0.2\n").unwrap_err();
+    assert_mentions(&msg, &["line 4", "NPTS"]);
+}
+
+#[test]
+fn at2_with_npts_0_says_npts_not_header_lines() {
+    // Before: "an AT2 file has 4 header lines" for a file that has them.
+    let msg = read_record("at2_npts_0", "r.AT2", b"h1\nh2\nh3\nNPTS= 0, DT= 0.01 SEC\n").unwrap_err();
+    assert_mentions(&msg, &["line 4", "NPTS = 0", "positive whole number"]);
+}
+
+#[test]
+fn record_with_a_utf8_bom_reads() {
+    // Before: the invisible BOM made line 1 "not a number".
+    let r = read_record("record_bom", "r.txt", b"\xEF\xBB\xBF0 0\n0.01 0.5\n0.02 0\n").unwrap();
+    assert_eq!(r.accel.len(), 3);
+}
+
+#[test]
+fn record_with_three_columns_is_refused_not_cut_to_two() {
+    // Before: the third column was dropped silently.
+    let (msg, rec) = record_error("three_column_record", "0 0 0\n0.01 0.1 0.2\n0.02 0 0\n");
+    assert_mentions(&msg, &[&rec.display().to_string(), "line 1", "third", "one component"]);
+}
+
+/// The column fixture with one line replaced (1-based), written to scratch.
+fn column_msh_with(test: &str, line: usize, new: &str) -> PathBuf {
+    let text = std::fs::read_to_string(fixture("column_hex.msh")).unwrap();
+    let mut lines: Vec<&str> = text.lines().collect();
+    lines[line - 1] = new;
+    let p = scratch(&format!("bad_input/{test}")).join("m.msh");
+    std::fs::write(&p, lines.join("\n") + "\n").unwrap();
+    p
+}
+
+#[test]
+fn msh_nodes_header_claiming_1e12_nodes_is_an_error_not_an_allocation() {
+    // Line 42 is the $Nodes header `blocks nodes min max` (44 nodes in 19 blocks).
+    let p = column_msh_with("msh_nodes_1e12", 42, "19 1000000000000 1 44");
+    let msg = Mesh::from_msh(p.clone()).unwrap_err().to_string();
+    assert_mentions(&msg, &[&p.display().to_string(), "claims 1000000000000 nodes", "hold 44"]);
+}
+
+#[test]
+fn msh_elements_header_claiming_more_elements_is_an_error() {
+    let p = column_msh_with("msh_elements_claim", 152, "7 52000000000 1 52");
+    let msg = Mesh::from_msh(p.clone()).unwrap_err().to_string();
+    assert_mentions(&msg, &["claims 52000000000 elements", "hold 52"]);
+}
+
+#[test]
+fn msh_2_2_says_re_export_as_4_1_instead_of_a_parser_dump() {
+    let p = column_msh_with("msh22", 2, "2.2 0 8");
+    let msg = Mesh::from_msh(p.clone()).unwrap_err().to_string();
+    assert_mentions(&msg, &[&p.display().to_string(), "this is MSH 2.2", "-format msh41"]);
+    assert!(!msg.contains("0x"), "no hex dump: {msg}");
+}
+
+#[test]
+fn msh_4_0_says_re_export_as_4_1() {
+    let p = column_msh_with("msh40", 2, "4 0 8");
+    let msg = Mesh::from_msh(p).unwrap_err().to_string();
+    assert_mentions(&msg, &["this is MSH 4", "msh41"]);
+}

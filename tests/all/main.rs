@@ -8,6 +8,7 @@ mod common;
 mod contact;
 mod contact_validation;
 mod dynamics;
+mod fuzz;
 mod mesh;
 mod outputs;
 mod report;
