@@ -170,9 +170,6 @@ pub struct TagSummary {
 
 /// A joint name made safe for a file name: characters other than letters, digits, `-`, `_` and
 /// `.` become `_`.
-fn joint_file_stem(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' }).collect()
-}
 
 /// Tag every joint of a scene: load the scene, mesh it, tag `scene.joints` in order (tolerance:
 /// the joint's `tolerance`, else [`DEFAULT_JOINT_TOLERANCE_RELATIVE`] × the mesh bounding-box
@@ -190,21 +187,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
         }
         .into());
     }
-    let mut stems: Vec<(String, &str)> = Vec::new();
-    for j in &scene.joints {
-        if j.name.is_empty() {
-            return Err(crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message: "joints: a joint has an empty `name`".into() }.into());
-        }
-        let stem = joint_file_stem(&j.name);
-        if let Some((_, other)) = stems.iter().find(|(s, _)| *s == stem) {
-            return Err(InterfaceError::Invalid {
-                joint: j.name.clone(),
-                message: format!("its output file name \"{stem}.vtu\" is also that of joint \"{other}\"; give the joints distinct names"),
-            }
-            .into());
-        }
-        stems.push((stem, &j.name));
-    }
+    // Joint names (non-empty, distinct file stems) are checked by `Scene::validate`.
     let mesh = load_mesh(&scene, opts)?;
     let model_size = mesh.diagonal();
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
@@ -213,7 +196,8 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
 
     let mut joints = Vec::with_capacity(scene.joints.len());
     let mut rows = Vec::with_capacity(scene.joints.len());
-    for (j, (stem, _)) in scene.joints.iter().zip(&stems) {
+    let stems: Vec<String> = scene.joints.iter().map(|j| crate::scene::joint_file_stem(&j.name)).collect();
+    for (j, stem) in scene.joints.iter().zip(&stems) {
         let spec = JointSpec { name: j.name.clone(), master: j.master.clone(), slave: j.slave.clone(), auto: j.auto };
         let (tolerance, source) = match j.tolerance {
             Some(t) => (t, "scene"),

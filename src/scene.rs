@@ -487,6 +487,48 @@ impl JointSceneSpec {
     }
 }
 
+/// Young's modulus accepted [Pa]: 1 kPa (a very soft soil) to 10 TPa (ten times diamond). Outside
+/// this the input is in the wrong unit, and the stable step becomes absurd (E 1e307 Pa would
+/// take ~10¹⁵⁰ steps a second; E 1e-300 Pa no step at all).
+pub const E_RANGE: (f64, f64) = (1e3, 1e13);
+/// Density accepted when positive [kg/m³]: 1 (air) to 10⁵ (five times osmium). 0 is allowed
+/// (a block without mass). Below, the stable step is NaN or absurd (rho 1e-300 gave dt = NaN).
+pub const RHO_RANGE: (f64, f64) = (1.0, 1e5);
+/// Largest traction component accepted [Pa] (10⁴ GPa) and nodal force [N]: beyond these the
+/// run overflows to inf (a 1e300 N force gave inf peaks and `null` in summary.json).
+pub const MAX_TRACTION: f64 = 1e13;
+pub const MAX_FORCE: f64 = 1e15;
+
+/// A load's vector within `max` and its ramp a finite time ≥ 0 [s].
+fn check_load(what: &str, field: &str, v: &[f64; 3], max: f64, unit: &str, ramp: f64) -> Result<(), String> {
+    if v.iter().any(|c| !(c.abs() <= max)) {
+        return Err(format!("{what}: {field} = {v:?} must be finite with components of at most {max:e} {unit}"));
+    }
+    if !(ramp >= 0.0 && ramp.is_finite()) {
+        return Err(format!("{what}: ramp = {ramp} must be a finite time ≥ 0 [s] (0 = step load)"));
+    }
+    Ok(())
+}
+
+/// The file stem of a joint's outputs (`joints/<stem>.pvd`, `tagging/<stem>.vtu`): its name with
+/// every character other than letters, digits, `-`, `_` and `.` replaced by `_`.
+pub fn joint_file_stem(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' }).collect()
+}
+
+/// A name that becomes a file name (scene → `<name>.pvd`, monitor → `histories/<name>.csv`):
+/// letters, digits, `_`, `-`, `.`, `:`, `+`, not starting with `.`, 1–100 characters, so that
+/// no name writes outside the output directory or makes a hidden file.
+pub fn check_file_name(field: &str, name: &str) -> Result<(), String> {
+    let ok_char = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+');
+    if name.is_empty() || name.len() > 100 || name.starts_with('.') || !name.chars().all(ok_char) {
+        return Err(format!(
+            "{field} \"{name}\" becomes a file name: use 1–100 letters, digits, `_`, `-`, `.` or `+`, not starting with `.` (no `/`, spaces or `..`)"
+        ));
+    }
+    Ok(())
+}
+
 impl Scene {
     /// Read and validate a scene file; relative paths are resolved against its directory.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
@@ -511,7 +553,10 @@ impl Scene {
             resolve(&mut b.record);
         }
         if scene.name.is_none() {
-            scene.name = Some(path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string());
+            // From the file name, with the characters a name may not hold replaced by `_`.
+            let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
+            let clean: String = stem.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+') { c } else { '_' }).collect();
+            scene.name = Some(clean.trim_start_matches('.').to_string()).filter(|n| !n.is_empty()).or(Some("scene".into()));
         }
         scene.validate().map_err(|message| SceneError::Invalid { path: path.to_path_buf(), message })?;
         Ok(scene)
@@ -534,6 +579,10 @@ impl Scene {
             (None, None) => return Err("geometry: give `geo` (a Gmsh script) or `msh` (a mesh file)".into()),
             _ => {}
         }
+        check_file_name("name", self.name())?;
+        if self.geometry.msh.is_some() && !self.geometry.set.is_empty() {
+            return Err("geometry.set: `-setnumber` parameters apply to a `.geo`, but this scene reads a ready `msh`. Remove `set`, or mesh the `.geo` instead.".into());
+        }
         if self.materials.is_empty() {
             return Err("materials: at least one material group is needed".into());
         }
@@ -541,11 +590,23 @@ impl Scene {
             if !(m.e > 0.0 && m.e.is_finite()) {
                 return Err(format!("material \"{}\": E = {} must be positive [Pa]", m.group, m.e));
             }
+            if !(E_RANGE.0..=E_RANGE.1).contains(&m.e) {
+                return Err(format!(
+                    "material \"{}\": E = {:e} Pa is outside {:e}–{:e} Pa (soft soil to diamond). Young's modulus is in Pa: 30 GPa is 30e9.",
+                    m.group, m.e, E_RANGE.0, E_RANGE.1
+                ));
+            }
             if !(0.0..0.5).contains(&m.nu) {
                 return Err(format!("material \"{}\": nu = {} must be in [0, 0.5)", m.group, m.nu));
             }
             if !(m.rho >= 0.0 && m.rho.is_finite()) {
                 return Err(format!("material \"{}\": rho = {} must be ≥ 0 [kg/m³]", m.group, m.rho));
+            }
+            if m.rho > 0.0 && !(RHO_RANGE.0..=RHO_RANGE.1).contains(&m.rho) {
+                return Err(format!(
+                    "material \"{}\": rho = {:e} kg/m³ is outside {:e}–{:e} kg/m³. Density is in kg/m³ (rock about 2000–3000).",
+                    m.group, m.rho, RHO_RANGE.0, RHO_RANGE.1
+                ));
             }
         }
         for b in &self.boundary {
@@ -566,6 +627,31 @@ impl Scene {
             if !(n > 0.0 && n.is_finite()) {
                 return Err(format!("loads.base {}: direction must be a non-zero vector", b.record.display()));
             }
+            if let Some(pga) = b.pga {
+                if !(pga > 0.0 && pga.is_finite()) {
+                    return Err(format!("loads.base {}: pga = {pga} must be positive [g]. To reverse the record's polarity, reverse its `direction`.", b.record.display()));
+                }
+            }
+            if let Some(sc) = b.scale {
+                if !(sc > 0.0 && sc.is_finite()) {
+                    return Err(format!("loads.base {}: scale = {sc} must be positive. To reverse the record's polarity, reverse its `direction`.", b.record.display()));
+                }
+            }
+        }
+        if let Some(g) = &self.loads.gravity {
+            let n = (g.direction[0].powi(2) + g.direction[1].powi(2) + g.direction[2].powi(2)).sqrt();
+            if !(n > 0.0 && n.is_finite()) {
+                return Err(format!("loads.gravity.direction = {:?} must be a non-zero vector (default [0, 0, -1])", g.direction));
+            }
+            if !(g.g > 0.0 && g.g.is_finite()) {
+                return Err(format!("loads.gravity.g = {} must be positive [m/s²] (default 9.81); the direction gives the sense", g.g));
+            }
+        }
+        for (k, t) in self.loads.traction.iter().enumerate() {
+            check_load(&format!("loads.traction[{k}] (group \"{}\")", t.group), "traction", &t.traction, MAX_TRACTION, "Pa", t.ramp)?;
+        }
+        for (k, f) in self.loads.nodal.iter().enumerate() {
+            check_load(&format!("loads.nodal[{k}]"), "force", &f.force, MAX_FORCE, "N", f.ramp)?;
         }
         if !(self.time.duration >= 0.0 && self.time.duration.is_finite()) {
             return Err(format!("time.duration = {} must be ≥ 0 [s]", self.time.duration));
@@ -579,6 +665,15 @@ impl Scene {
             if !(c > 0.0 && c <= 1.0) {
                 return Err(format!("time.courant = {c} must be in (0, 1]"));
             }
+        }
+        if !(self.time.energy_tolerance > 0.0 && self.time.energy_tolerance.is_finite()) {
+            return Err(format!("time.energy_tolerance = {} must be positive (default 0.05)", self.time.energy_tolerance));
+        }
+        if !(self.equilibrium.tolerance > 0.0 && self.equilibrium.tolerance.is_finite()) {
+            return Err(format!("equilibrium.tolerance = {} must be positive (default 1e-6)", self.equilibrium.tolerance));
+        }
+        if !(self.equilibrium.max_residual > 0.0 && self.equilibrium.max_residual.is_finite()) {
+            return Err(format!("equilibrium.max_residual = {} must be positive (default 1e-3)", self.equilibrium.max_residual));
         }
         if self.time.dt.is_some() && self.time.courant.is_some() {
             return Err("time: give `dt` or `courant`, not both".into());
@@ -603,6 +698,35 @@ impl Scene {
         for j in &self.joints {
             if j.mu.is_some() && j.phi.is_some() {
                 return Err(format!("joint \"{}\": give `mu` or `phi`, not both", j.name));
+            }
+        }
+        let mut monitors = std::collections::BTreeSet::new();
+        for m in &self.output.monitor {
+            check_file_name("output.monitor name", &m.name)?;
+            if !monitors.insert(m.name.as_str()) {
+                return Err(format!("output.monitor: two monitors are named \"{}\" (each writes histories/{}.csv): give each its own name", m.name, m.name));
+            }
+        }
+        let mut joint_stems: BTreeMap<String, &str> = BTreeMap::new();
+        let mut joint_sides = std::collections::BTreeMap::new();
+        for j in &self.joints {
+            if j.name.is_empty() {
+                return Err("joints: a joint has an empty `name`".into());
+            }
+            let stem = joint_file_stem(&j.name);
+            if let Some(other) = joint_stems.get(&stem) {
+                return Err(format!("joint \"{}\": its output file name \"{stem}.vtu\" is also that of joint \"{other}\"; give the joints distinct names", j.name));
+            }
+            joint_stems.insert(stem, j.name.as_str());
+            let key = if j.master <= j.slave { (j.master.as_str(), j.slave.as_str()) } else { (j.slave.as_str(), j.master.as_str()) };
+            if let Some(other) = joint_sides.insert(key, j.name.as_str()) {
+                return Err(format!(
+                    "joints \"{other}\" and \"{}\" both join \"{}\" and \"{}\": the contact would be applied twice. Keep one.",
+                    j.name, key.0, key.1
+                ));
+            }
+            if j.master == j.slave {
+                return Err(format!("joint \"{}\": master and slave are the same group \"{}\"", j.name, j.master));
             }
         }
         self.damping.coefficients()?;

@@ -432,3 +432,114 @@ fn msh_4_0_says_re_export_as_4_1() {
     let msg = Mesh::from_msh(p).unwrap_err().to_string();
     assert_mentions(&msg, &["this is MSH 4", "msh41"]);
 }
+
+// ---- issue 19 §2: inputs that ran with exit 0 and a silently wrong (or no) answer.
+
+#[test]
+fn rho_1e_300_is_refused_instead_of_dt_nan_and_zero_steps() {
+    let mut s = column_scene();
+    s["materials"][0]["rho"] = json!(1e-300);
+    assert_mentions(&run_error("rho_tiny", &s), &["block:column", "rho = 1e-300", "kg/m³"]);
+}
+
+#[test]
+fn e_1e_300_is_refused_instead_of_zero_steps() {
+    let mut s = column_scene();
+    s["materials"][0]["E"] = json!(1e-300);
+    assert_mentions(&run_error("e_tiny", &s), &["block:column", "E = 1e-300", "in Pa"]);
+}
+
+#[test]
+fn e_1e307_is_refused_instead_of_running_for_ever() {
+    let mut s = column_scene();
+    s["materials"][0]["E"] = json!(1e307);
+    assert_mentions(&run_error("e_huge", &s), &["E = 1e307"]);
+}
+
+#[test]
+fn force_1e300_is_refused_instead_of_inf_peaks() {
+    let mut s = column_scene();
+    s["loads"] = json!({"nodal": [{"point": [0, 0, 10], "force": [1e300, 0, 0]}]});
+    assert_mentions(&run_error("force_huge", &s), &["loads.nodal[0]", "force"]);
+}
+
+#[test]
+fn negative_ramp_is_refused() {
+    let mut s = column_scene();
+    s["loads"] = json!({"traction": [{"group": "load:top", "traction": [0, 0, -1e5], "ramp": -1.0}]});
+    assert_mentions(&run_error("negative_ramp", &s), &["loads.traction[0]", "load:top", "ramp = -1"]);
+}
+
+#[test]
+fn pga_0_and_negative_scale_are_refused() {
+    for (k, v, want) in [("pga", 0.0, "pga = 0"), ("scale", -1.0, "scale = -1"), ("pga", -0.5, "pga = -0.5")] {
+        let mut s = column_scene();
+        s["loads"] = json!({"base": [{"record": "r.txt", "direction": [1, 0, 0], k: v}]});
+        assert_mentions(&run_error(&format!("base_{k}_{v}"), &s), &[want, "reverse its `direction`"]);
+    }
+}
+
+#[test]
+fn negative_energy_and_equilibrium_tolerances_are_refused() {
+    let mut s = column_scene();
+    s["time"]["energy_tolerance"] = json!(-0.1);
+    assert_mentions(&run_error("neg_energy_tol", &s), &["time.energy_tolerance = -0.1"]);
+    let mut s = column_scene();
+    s["equilibrium"] = json!({"tolerance": -1e-6});
+    assert_mentions(&run_error("neg_eq_tol", &s), &["equilibrium.tolerance = -0.000001"]);
+}
+
+#[test]
+fn gravity_direction_zero_is_named_not_time_step_too_large() {
+    let mut s = column_scene();
+    s["loads"] = json!({"gravity": {"direction": [0, 0, 0]}});
+    assert_mentions(&run_error("gravity_zero_dir", &s), &["loads.gravity.direction", "non-zero"]);
+    let mut s = column_scene();
+    s["loads"] = json!({"gravity": {"g": -9.81}});
+    assert_mentions(&run_error("gravity_negative_g", &s), &["loads.gravity.g = -9.81"]);
+}
+
+#[test]
+fn geometry_set_with_msh_is_refused() {
+    let mut s = column_scene();
+    s["geometry"]["set"] = json!({"h": 0.5});
+    assert_mentions(&run_error("set_with_msh", &s), &["geometry.set", "`msh`"]);
+}
+
+#[test]
+fn scene_names_that_escape_the_output_directory_are_refused() {
+    // Before: name "/" wrote /.pvd at the filesystem root; "../../x" wrote outside --out; "" a hidden file.
+    for (k, name) in ["/", "../../x", "", ".hidden", "a b"].iter().enumerate() {
+        let mut s = column_scene();
+        s["name"] = json!(name);
+        assert_mentions(&run_error(&format!("bad_name_{k}"), &s), &["name", "becomes a file name"]);
+    }
+}
+
+#[test]
+fn monitor_names_that_escape_or_collide_are_refused() {
+    let mut s = column_scene();
+    s["output"]["monitor"] = json!([{"name": "../../evil", "point": [0, 0, 0]}]);
+    assert_mentions(&run_error("monitor_escape", &s), &["output.monitor name", "../../evil"]);
+    let mut s = column_scene();
+    s["output"]["monitor"] = json!([{"name": "top", "point": [0, 0, 0]}, {"name": "top", "point": [0, 0, 10]}]);
+    assert_mentions(&run_error("monitor_twice", &s), &["two monitors are named \"top\""]);
+}
+
+#[test]
+fn two_joints_on_the_same_pair_of_groups_are_refused() {
+    let mut s = column_scene();
+    s["joints"] = json!([
+        {"name": "J1", "master": "bc:base", "slave": "load:top"},
+        {"name": "J2", "master": "load:top", "slave": "bc:base"}
+    ]);
+    assert_mentions(&run_error("joint_twice", &s), &["\"J1\" and \"J2\"", "applied twice"]);
+}
+
+#[test]
+fn a_scene_file_name_with_spaces_gives_a_clean_default_name() {
+    let dir = scratch("bad_input/spaced_name");
+    let p = dir.join("my scene.json");
+    std::fs::write(&p, column_scene().to_string()).unwrap();
+    assert_eq!(Scene::load(&p).unwrap().name(), "my_scene");
+}
