@@ -261,7 +261,7 @@ fn simulate(
     let monitors = snap_monitors(&model, &scene)?;
     let mut history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
     let mut frames = if scene.output.frames { Some(FrameWriter::create(&out_dir, scene.name(), &model)?) } else { None };
-    let mut joint_out = if model.joints.is_empty() { None } else { Some(JointWriter::create(&out_dir, &model.joints, scene.output.frames)?) };
+    let mut joint_out = if model.joints.is_empty() { None } else { Some(JointWriter::create(&out_dir, &model.joints, scene.output.frames, scene.output.joint_forces)?) };
     if let (Some(jw), Some(c)) = (joint_out.as_mut(), contact.as_ref()) {
         for (p, j) in jw.peaks.iter_mut().zip(&model.joints) {
             p.gs_tolerance = if matches!(j.method, crate::contact::joint::Method::Penalty { .. }) { 0.0 } else { c.gs_tolerance };

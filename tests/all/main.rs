@@ -14,3 +14,4 @@ mod report;
 mod rigid;
 mod tagging;
 mod wedge;
+mod wedge_mechanism;
