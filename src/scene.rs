@@ -309,6 +309,13 @@ pub struct OutputSpec {
     /// Write VTU frames at all. Default true (studies switch it off for sweeps).
     #[serde(default = "yes")]
     pub frames: bool,
+    /// Also write the per-joint force diagnostic `histories/joint_<joint>_forces.csv` (pairs in
+    /// contact, lost and slipping, open/close transitions, resultant normal and tangential
+    /// force, Mohr-Coulomb capacity and cohesion carried, Gauss–Seidel residual; one row per
+    /// history row, docs/contact.md). Default false: a research diagnostic, not an output an
+    /// ordinary run needs.
+    #[serde(default)]
+    pub joint_forces: bool,
 }
 
 fn one() -> usize {
@@ -320,7 +327,7 @@ fn yes() -> bool {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: 1, monitor: vec![], frames: true }
+        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: 1, monitor: vec![], frames: true, joint_forces: false }
     }
 }
 

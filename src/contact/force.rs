@@ -814,7 +814,7 @@ impl ContactSolver<'_> {
     /// The Gauss–Seidel sweeps over the active pairs; returns the sweeps made and whether they
     /// reached `gs_tolerance`.
     #[inline(never)]
-    fn sweep_into(&mut self, u_next: &mut [f64]) -> (usize, bool) {
+    fn sweep_into(&mut self, u_next: &mut [f64]) -> (usize, bool, f64) {
         let mut clock = 1u32;
         // A node moved by less than 1 % of the tolerance does not call its pairs back: their
         // forces would change by a fraction of that (the fixed point is the same to within the
@@ -837,6 +837,7 @@ impl ContactSolver<'_> {
         // last). The mode depends only on the iterates: deterministic.
         let mut listed = false;
         let mut moving = active.len();
+        let mut residual = 0.0;
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
             if !listed && 2 * moving < active.len() {
@@ -850,6 +851,7 @@ impl ContactSolver<'_> {
                 sweep_pass::<false>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
             };
             let max_du = sweep_change_into(local, sweep_start).sqrt();
+            residual = max_du;
             converged = max_du <= *gs_tolerance || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
         }
         // the corrected displacements back into the prediction
@@ -859,16 +861,17 @@ impl ContactSolver<'_> {
             v[1] = l.x[1];
             v[2] = l.x[2];
         }
-        (sweeps, converged)
+        (sweeps, converged, residual)
     }
 
     /// Write the active pairs' results into the history and return the contact work of the
     /// step [J].
     #[inline(never)]
-    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, u_prev: &[f64]) -> f64 {
+    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, residual: f64, u_prev: &[f64]) -> f64 {
         let mut work = 0.0;
         for rec in history.joints.iter_mut() {
             rec.sweeps = sweeps;
+            rec.gs_residual = residual;
             rec.max_sweeps = rec.max_sweeps.max(sweeps);
             if !converged {
                 rec.unconverged_steps += 1;
@@ -916,9 +919,9 @@ impl Constraint<ContactState> for ContactSolver<'_> {
         let t_prepare = now_if(timed);
         self.prepare_sweeps_into(u_next);
         let t_sweeps = now_if(timed);
-        let (sweeps, converged) = self.sweep_into(u_next);
+        let (sweeps, converged, residual) = self.sweep_into(u_next);
         let t_record = now_if(timed);
-        let work = penalty_work + self.record_into(history, sweeps, converged, u_prev);
+        let work = penalty_work + self.record_into(history, sweeps, converged, residual, u_prev);
         if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {
             t.search += b - a;
             t.prepare += c - b;

@@ -55,6 +55,9 @@ pub struct JointRecord {
     pub max_sweeps: usize,
     /// Steps whose Gauss–Seidel did not reach the tolerance.
     pub unconverged_steps: u64,
+    /// The last sweep's largest net node change of the last step [m] (its residual: below
+    /// `gs_tolerance` when converged; the amount left when the sweep budget ran out).
+    pub gs_residual: f64,
 }
 
 /// Contact history of all joints (part of the run's `State`).

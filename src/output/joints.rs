@@ -50,7 +50,22 @@ pub struct JointWriter {
     csv: Vec<(PathBuf, BufWriter<std::fs::File>)>,
     pub peaks: Vec<JointPeaks>,
     frames: bool,
+    /// The opt-in force diagnostic (`output.joint_forces`): per joint its CSV and, per pair,
+    /// whether it was closed at the last row (for the open/close transitions).
+    forces: Vec<(PathBuf, BufWriter<std::fs::File>, Vec<bool>)>,
 }
+
+/// Header of `histories/joint_<joint>_forces.csv` (the opt-in force diagnostic, see
+/// [`JointWriter::create`]): per row (the joint's history rows), the pairs in contact
+/// (`closed`: state stick, slip or bonded), those that found no master face (`lost`), those
+/// at the Mohr-Coulomb limit (`slipping`), the pairs that opened or closed since the last row
+/// (`transitions`), the tributary area in contact and lost [m²], the cohesion c A of the lost
+/// pairs [N], the sum of the compressive normal forces [N], the resultant normal and tangential
+/// forces on the slave side [N, x y z], the sum of |r_t| [N], the sum over the closed pairs of
+/// their Mohr-Coulomb limit μ r_n + c A (`capacity`) and of their cohesive part c A
+/// (`cohesion`) [N], the step's Gauss–Seidel sweeps and last-sweep residual [m], and the open
+/// pairs (not lost) with a gap below 1 nm, 1 µm and 1 mm.
+pub const JOINT_FORCES_HEADER: &str = "t,closed,lost,slipping,transitions,area_closed,area_lost,cohesion_lost,normal_sum,nx,ny,nz,tx,ty,tz,shear_sum,capacity,cohesion,sweeps,gs_residual,open_1nm,open_1um,open_1mm";
 
 fn state_counts(r: &JointRecord) -> [usize; 4] {
     let mut c = [0; 4];
@@ -61,7 +76,10 @@ fn state_counts(r: &JointRecord) -> [usize; 4] {
 }
 
 impl JointWriter {
-    pub fn create(out_dir: &Path, joints: &[ContactJoint], frames: bool) -> Result<JointWriter, OutputError> {
+    /// `forces`: also write the force diagnostic `histories/joint_<joint>_forces.csv`
+    /// ([`JOINT_FORCES_HEADER`]; scene `output.joint_forces`, default off: about 200 B per
+    /// joint and history row, for studies of what a joint carries).
+    pub fn create(out_dir: &Path, joints: &[ContactJoint], frames: bool, forces: bool) -> Result<JointWriter, OutputError> {
         let dir = out_dir.join("joints");
         let hdir = out_dir.join("histories");
         for d in [&dir, &hdir] {
@@ -88,7 +106,17 @@ impl JointWriter {
                 ..Default::default()
             });
         }
-        Ok(JointWriter { dir, series, csv, peaks, frames })
+        let mut fcsv = Vec::new();
+        if forces {
+            for j in joints {
+                let p = hdir.join(format!("joint_{}_forces.csv", j.tag.name));
+                let f = std::fs::File::create(&p).map_err(|e| OutputError::write(&p, e))?;
+                let mut w = BufWriter::new(f);
+                writeln!(w, "{JOINT_FORCES_HEADER}").map_err(|e| OutputError::write(&p, e))?;
+                fcsv.push((p, w, vec![false; j.tag.n_slave()]));
+            }
+        }
+        Ok(JointWriter { dir, series, csv, peaks, frames, forces: fcsv })
     }
 
     /// Update maxima and append a history row per joint at time `t`.
@@ -125,7 +153,10 @@ impl JointWriter {
             let (p, w) = &mut self.csv[k];
             writeln!(w, "{t:.9e},{mo:.9e},{ms:.9e},{md:.9e},{mp:.9e},{},{},{},{},{},{fn_:.9e},{ft:.9e}", c[0], c[1], c[2], c[3], r.sweeps)
                 .map_err(|e| OutputError::write(p.as_path(), e))?;
-            let _ = j;
+            if let Some((p, w, was_closed)) = self.forces.get_mut(k) {
+                let row = force_row(j, r, was_closed);
+                writeln!(w, "{t:.9e},{row}").map_err(|e| OutputError::write(p.as_path(), e))?;
+            }
         }
         Ok(())
     }
@@ -133,6 +164,9 @@ impl JointWriter {
     /// Flush the CSV histories (rows written so far reach the disk).
     pub fn flush(&mut self) -> Result<(), OutputError> {
         for (p, w) in &mut self.csv {
+            w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
+        }
+        for (p, w, _) in &mut self.forces {
             w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
         }
         Ok(())
@@ -197,6 +231,119 @@ impl JointWriter {
     }
 
     pub fn csv_paths(&self) -> Vec<PathBuf> {
-        self.csv.iter().map(|(p, _)| p.clone()).collect()
+        self.csv.iter().map(|(p, _)| p.clone()).chain(self.forces.iter().map(|(p, _, _)| p.clone())).collect()
     }
+}
+
+/// One row of the force diagnostic after `t` (see [`JOINT_FORCES_HEADER`]); `was_closed` is
+/// updated to the pairs' current contact.
+fn force_row(j: &ContactJoint, r: &JointRecord, was_closed: &mut [bool]) -> String {
+    let (mut closed, mut lost, mut slipping, mut transitions) = (0usize, 0usize, 0usize, 0usize);
+    let (mut area_closed, mut area_lost, mut coh_lost, mut nsum, mut tabs, mut cap, mut coh) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut fnv, mut ftv) = ([0.0f64; 3], [0.0f64; 3]);
+    let mut bins = [0usize; 3];
+    for (i, p) in r.pairs.iter().enumerate() {
+        let a = j.tag.areas[i];
+        let is_closed = p.state != PairState::Open;
+        if is_closed != was_closed[i] {
+            transitions += 1;
+        }
+        was_closed[i] = is_closed;
+        if !is_closed && p.gap.is_finite() {
+            for (b, lim) in [1e-9, 1e-6, 1e-3].iter().enumerate() {
+                if p.gap < *lim {
+                    bins[b] += 1;
+                }
+            }
+        }
+        if !p.gap.is_finite() {
+            lost += 1;
+            area_lost += a;
+            coh_lost += j.law.cohesion_force(&p.hist, a);
+        }
+        if !is_closed {
+            continue;
+        }
+        closed += 1;
+        area_closed += a;
+        if p.state == PairState::Slip {
+            slipping += 1;
+        }
+        let [n, t1, t2] = j.frames[i];
+        for c in 0..3 {
+            fnv[c] -= n[c] * p.r_n;
+            ftv[c] += t1[c] * p.r_t[0] + t2[c] * p.r_t[1];
+        }
+        nsum += p.r_n;
+        tabs += (p.r_t[0] * p.r_t[0] + p.r_t[1] * p.r_t[1]).sqrt();
+        cap += j.law.shear_limit(p.r_n, &p.hist, a);
+        coh += j.law.cohesion_force(&p.hist, a);
+    }
+    format!(
+        "{closed},{lost},{slipping},{transitions},{area_closed:.6e},{area_lost:.6e},{coh_lost:.6e},{nsum:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{:.9e},{tabs:.9e},{cap:.9e},{coh:.9e},{},{:.3e},{},{},{}",
+        fnv[0], fnv[1], fnv[2], ftv[0], ftv[1], ftv[2], r.sweeps, r.gs_residual, bins[0], bins[1], bins[2]
+    )
+}
+
+/// One row of `histories/joint_<joint>_forces.csv` (see [`JOINT_FORCES_HEADER`] for the
+/// meaning and units of each column).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct JointForcesRow {
+    pub t: f64,
+    pub closed: usize,
+    pub lost: usize,
+    pub slipping: usize,
+    pub transitions: usize,
+    pub area_closed: f64,
+    pub area_lost: f64,
+    pub cohesion_lost: f64,
+    pub normal_sum: f64,
+    pub normal: [f64; 3],
+    pub tangential: [f64; 3],
+    pub shear_sum: f64,
+    pub capacity: f64,
+    pub cohesion: f64,
+    pub sweeps: usize,
+    pub gs_residual: f64,
+    /// Open pairs (not lost) with a gap below 1 nm, 1 µm and 1 mm.
+    pub open_below: [usize; 3],
+}
+
+/// Read a force diagnostic written by [`JointWriter`] with `forces` on. The error names the
+/// file and the line.
+pub fn read_joint_forces(path: &Path) -> Result<Vec<JointForcesRow>, OutputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
+    let mut lines = text.lines();
+    if lines.next() != Some(JOINT_FORCES_HEADER) {
+        return Err(OutputError::read(path, format!("the first line is not the force diagnostic's header `{JOINT_FORCES_HEADER}`")));
+    }
+    let mut rows = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let bad = |what: &str| OutputError::read(path, format!("line {}: {what}", k + 2));
+        let v: Vec<f64> = line.split(',').map(|s| s.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| bad(&e.to_string()))?;
+        if v.len() != 23 {
+            return Err(bad(&format!("{} columns, expected 23", v.len())));
+        }
+        let n = |i: usize| v[i] as usize;
+        rows.push(JointForcesRow {
+            t: v[0],
+            closed: n(1),
+            lost: n(2),
+            slipping: n(3),
+            transitions: n(4),
+            area_closed: v[5],
+            area_lost: v[6],
+            cohesion_lost: v[7],
+            normal_sum: v[8],
+            normal: [v[9], v[10], v[11]],
+            tangential: [v[12], v[13], v[14]],
+            shear_sum: v[15],
+            capacity: v[16],
+            cohesion: v[17],
+            sweeps: n(18),
+            gs_residual: v[19],
+            open_below: [n(20), n(21), n(22)],
+        });
+    }
+    Ok(rows)
 }

@@ -116,7 +116,7 @@ impl Recorder {
         let monitors = snap_monitors(model, scene)?;
         let history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
         let frames = if scene.output.frames { Some(FrameWriter::create(out_dir, scene.name(), model)?) } else { None };
-        let mut joints = if p.joints.is_empty() { None } else { Some(JointWriter::create(out_dir, &p.joints, scene.output.frames)?) };
+        let mut joints = if p.joints.is_empty() { None } else { Some(JointWriter::create(out_dir, &p.joints, scene.output.frames, scene.output.joint_forces)?) };
         if let (Some(jw), Some(c)) = (joints.as_mut(), sim.contact.as_ref()) {
             for (pk, j) in jw.peaks.iter_mut().zip(&p.joints) {
                 pk.gs_tolerance = if matches!(j.method, Method::Penalty { .. }) { 0.0 } else { c.gs_tolerance };

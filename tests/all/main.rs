@@ -15,3 +15,4 @@ mod report;
 mod rigid;
 mod tagging;
 mod wedge;
+mod wedge_mechanism;
