@@ -186,7 +186,7 @@ fn added_inertia_moves_with_the_full_block_but_adds_no_weight() {
         pb.model.add_inertia(node, n * n.transpose() * m_a);
     }
     assert_eq!(pb.model.mass.blocks.len(), top.len());
-    let weight: f64 = pb.model.mass.gravitational.iter().sum::<f64>() * 9.81;
+    let weight: f64 = pb.model.mass.total_weight_mass() * 9.81;
     let mut sim = Simulation::new(&pb).unwrap();
     let steps = 300;
     for _ in 0..steps {
