@@ -35,6 +35,7 @@ pub mod pipeline;
 pub mod report;
 pub mod rigid;
 pub mod scene;
+pub mod studies;
 pub mod study;
 
 pub use error::{Error, Result};

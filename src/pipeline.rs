@@ -10,7 +10,7 @@ use crate::model::Model;
 use crate::output::frames::{FrameWriter, Kinematics};
 use crate::output::history::{HistoryWriter, Monitor};
 use crate::scene::Scene;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -32,7 +32,7 @@ pub struct RunOptions {
 }
 
 /// Peak of a quantity and where it happened.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Peak {
     pub value: f64,
     pub t: f64,
@@ -40,7 +40,7 @@ pub struct Peak {
 }
 
 /// What a run reports (written as `summary.json`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RunSummary {
     pub scene: String,
     pub mesh: PathBuf,
@@ -405,6 +405,13 @@ fn simulate(
 }
 
 impl RunSummary {
+    /// Read a `summary.json` written by [`run`]: every field typed, so a missing field or a
+    /// wrong type is an error naming the file (no defaults are filled in).
+    pub fn read(path: &Path) -> Result<RunSummary, crate::error::OutputError> {
+        let text = std::fs::read_to_string(path).map_err(|e| crate::error::OutputError::read(path, e))?;
+        serde_json::from_str(&text).map_err(|e| crate::error::OutputError::read(path, format!("not a run summary: {e}")))
+    }
+
     /// One screen of text for the end of a run.
     pub fn to_text(&self) -> String {
         let mut s = String::new();

@@ -56,7 +56,7 @@ pub struct PairRecord {
 }
 
 /// Counters of search events per joint.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SearchEvents {
     /// Projections found only in Layer2 after leaving Layer1.
     pub widened_layer2: u64,

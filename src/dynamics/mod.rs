@@ -76,7 +76,7 @@ fn for_each_entry(v: &mut [f64], f: impl Fn(usize, &mut f64) + Sync + Send) {
 }
 
 /// Running energy account of the dynamic stage [J].
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energy {
     pub kinetic: f64,
     pub strain: f64,
@@ -414,7 +414,7 @@ impl ExplicitSolver {
 }
 
 /// Outcome of gravity equilibration.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct EquilibriumInfo {
     pub steps: usize,
     /// ‖M a‖ / ‖F_gravity‖ over free components at the end.
