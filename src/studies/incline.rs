@@ -67,7 +67,6 @@ pub struct InclineRun {
     pub newmark_episodes: usize,
     /// (FEM − Newmark) / Newmark (none when Newmark does not slide).
     pub difference: Option<f64>,
-    pub failed: Option<String>,
 }
 
 impl InclineKind {
@@ -132,7 +131,6 @@ impl InclineKind {
             newmark_slip: nm.residual_displacement,
             newmark_episodes: nm.n_episodes,
             difference,
-            failed: r.failed().map(str::to_string),
         })
     }
 }
@@ -161,10 +159,12 @@ impl StudyKind for InclineKind {
     fn report(&self, results: &StudyResults) -> Result<KindReport, Error> {
         let mut rows = Vec::new();
         let mut unreadable = Vec::new();
+        let mut stopped = Vec::new();
         for r in results.runs.iter().filter(|r| r.has_results()) {
-            match self.run(r) {
-                Ok(x) => rows.push(x),
-                Err(e) => unreadable.push((r.spec.id.clone(), e.to_string())),
+            match (r.failed(), self.run(r)) {
+                (Some(e), _) => stopped.push((r.spec.id.clone(), e.to_string())),
+                (None, Ok(x)) => rows.push(x),
+                (None, Err(e)) => unreadable.push((r.spec.id.clone(), e.to_string())),
             }
         }
         rows.sort_by(|a, b| a.phi.total_cmp(&b.phi).then(a.pga.total_cmp(&b.pga)));
@@ -177,9 +177,8 @@ impl StudyKind for InclineKind {
         let mut t = Table::new(["φ [deg]", "PGA [g]", "yield acc. [g]", "FEM slip", "Newmark slip", "Newmark episodes", "FEM − Newmark", "run"]);
         let mut flagged = Vec::new();
         for r in &rows {
-            let diff = match (&r.failed, r.difference) {
-                (Some(_), _) => "run failed".to_string(),
-                (None, Some(d)) => {
+            let diff = match r.difference {
+                Some(d) => {
                     if d.abs() > p.tolerance {
                         flagged.push(r.id.clone());
                         format!("{} (outside {})", fmt_percent(d, 1), fmt_percent(p.tolerance, 0))
@@ -187,16 +186,15 @@ impl StudyKind for InclineKind {
                         fmt_percent(d, 1)
                     }
                 }
-                (None, None) => format!("Newmark: no slip (FEM {})", m(r.fem_slip)),
+                None => format!("Newmark: no slip (FEM {})", m(r.fem_slip)),
             };
             let _ = t.push_row([m(r.phi), m(r.pga), m(r.yield_acceleration), m(r.fem_slip), m(r.newmark_slip), r.newmark_episodes.to_string(), diff, format!("`{}`", r.id)]);
         }
         md.push_str(&t.to_markdown());
-        let failed: Vec<&InclineRun> = rows.iter().filter(|r| r.failed.is_some()).collect();
-        if !failed.is_empty() {
-            let _ = writeln!(md, "\nRuns stopped by their checks (their slip is where they stopped):\n");
-            for r in failed {
-                let _ = writeln!(md, "- `{}`: {}", r.id, r.failed.as_deref().unwrap_or(""));
+        if !stopped.is_empty() {
+            let _ = writeln!(md, "\nRuns stopped by an error (left out of the table):\n");
+            for (id, e) in &stopped {
+                let _ = writeln!(md, "- `{id}`: {e}");
             }
         }
         // chart: slip against PGA, one FEM series and one Newmark series per friction angle
@@ -204,7 +202,7 @@ impl StudyKind for InclineKind {
         phis.dedup();
         let mut c = Chart::new(format!("Residual slip against PGA, {}° incline", m(p.beta)), "PGA [g]", "residual slip down the slope [m]");
         for &phi in &phis {
-            let of = |f: &dyn Fn(&InclineRun) -> f64| rows.iter().filter(|r| r.phi == phi && r.failed.is_none()).map(|r| (r.pga, f(r))).collect::<Vec<_>>();
+            let of = |f: &dyn Fn(&InclineRun) -> f64| rows.iter().filter(|r| r.phi == phi).map(|r| (r.pga, f(r))).collect::<Vec<_>>();
             c.series.push(Series::markers(format!("FEM, φ = {}°", m(phi)), of(&|r| r.fem_slip)));
             c.series.push(Series::line(format!("rigid Newmark, φ = {}°", m(phi)), of(&|r| r.newmark_slip)));
         }
@@ -221,6 +219,6 @@ impl StudyKind for InclineKind {
         if !flagged.is_empty() {
             lines.push(format!("outside {}: {}", fmt_percent(p.tolerance, 0), flagged.join(", ")));
         }
-        Ok(KindReport { markdown: md, json: serde_json::json!({ "runs": rows }), charts, lines, unreadable, lists_failed: true })
+        Ok(KindReport { markdown: md, json: serde_json::json!({ "runs": rows, "stopped": stopped }), charts, lines, unreadable, lists_failed: true })
     }
 }

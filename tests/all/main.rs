@@ -12,5 +12,6 @@ mod mesh;
 mod outputs;
 mod report;
 mod rigid;
+mod study;
 mod tagging;
 mod wedge;

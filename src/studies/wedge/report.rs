@@ -384,10 +384,14 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     let line_length = (geom.p[0].powi(2) + geom.p[1].powi(2) + geom.p[2].powi(2)).sqrt();
     let mut runs = Vec::new();
     let mut unreadable = Vec::new();
+    // failed runs whose histories cannot be read (stopped before the first step): listed
+    // with the stopped runs
+    let mut stopped_early = Vec::new();
     for res in results.runs.iter().filter(|r| r.has_results()) {
-        match read_run(kind, res, base, e, line_length) {
-            Ok(r) => runs.push(r),
-            Err(err) => unreadable.push((res.spec.id.clone(), err.to_string())),
+        match (read_run(kind, res, base, e, line_length), res.failed()) {
+            (Ok(r), _) => runs.push(r),
+            (Err(_), Some(f)) => stopped_early.push((res.spec.id.clone(), f.to_string())),
+            (Err(err), None) => unreadable.push((res.spec.id.clone(), err.to_string())),
         }
     }
     let ssr: Option<StudySsr> = match results.step::<StudySsr>("ssr") {
@@ -689,10 +693,13 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     }
     md.push_str(&t.to_markdown());
     let stopped: Vec<&WedgeRun> = runs.iter().filter(|r| r.failed.is_some()).collect();
-    if !stopped.is_empty() {
+    if !stopped.is_empty() || !stopped_early.is_empty() {
         let _ = writeln!(md, "\nRuns stopped by their checks (the slip they had reached is a lower bound):\n");
         for r in stopped {
             let _ = writeln!(md, "- `{}`: {}", r.spec.id, r.failed.as_deref().unwrap_or("").trim_start_matches("error: "));
+        }
+        for (id, f) in &stopped_early {
+            let _ = writeln!(md, "- `{id}` (before its first history row): {f}");
         }
     }
     let _ = writeln!(md, "\n![slip against PGA](charts/slip_vs_pga.svg)\n");
