@@ -117,7 +117,7 @@ pub enum InterfaceError {
     Mesh(#[from] MeshError),
 }
 
-/// Loading a study file or planning its runs ([`crate::study`]): names the study file and the
+/// Loading a study file or planning its runs (the `study` module): names the study file and the
 /// field (or the run) to fix.
 #[derive(Debug, Error)]
 pub enum StudyError {

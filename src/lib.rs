@@ -20,6 +20,8 @@
 //! - time integration, damping, stable step: [`dynamics`]
 //! - errors (what the user must fix): [`error`]
 //! - charts (PNG + SVG) and Markdown tables for study reports: [`report`]
+//! - study files, run ids, the results layout: [`study`] (and `docs/studies.md`); what each
+//!   study adds (metrics, tables, charts): [`studies`]
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages.
 

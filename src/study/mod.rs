@@ -4,7 +4,7 @@
 //! or a listed union of selections, per-run overrides), the plan ([`plan`]: each run's id,
 //! scene and directory, `plan.json`, the Makefile `runs.mk` for `make -j`), the typed reading
 //! of results and the report scaffold ([`results`]). It owns no physics and knows no
-//! particular study: a study kind ([`StudyKind`], registered in [`crate::studies`]) adds only
+//! particular study: a study kind ([`StudyKind`], registered in the top-level `studies` module) adds only
 //! its metrics, tables and charts, and any steps of its own (the wedge's strength reduction).
 //! Two procedures studies call live here too: FEM strength reduction ([`ssr`]) and the
 //! rigid-block level of a wedge ([`rigid_level`]).
