@@ -145,7 +145,7 @@ impl StudyKind for InclineKind {
         if !(p.uphill[0].is_finite() && p.uphill[1].is_finite()) || p.uphill[0].hypot(p.uphill[1]) == 0.0 {
             return Err(invalid(format!("`uphill` = {:?} must be a non-zero horizontal direction", p.uphill)));
         }
-        if !(p.tolerance > 0.0) {
+        if p.tolerance.is_nan() || p.tolerance <= 0.0 {
             return Err(invalid(format!("`tolerance` = {} must be positive", p.tolerance)));
         }
         let base = Scene::load(&study.scene)?;

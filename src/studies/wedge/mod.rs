@@ -260,10 +260,10 @@ impl StudyKind for WedgeKind {
         if !(p.enough > 0.0 && p.enough < 1.0) {
             return Err(invalid(format!("`enough` = {} must be a fraction in (0, 1)", p.enough)));
         }
-        if let Some(s) = &p.ssr {
-            if !(s.bracket[0] > 0.0 && s.bracket[0] < s.bracket[1]) || !(s.tolerance > 0.0) || !(s.slip_limit > 0.0) || s.max_steps == 0 {
-                return Err(invalid(format!("`ssr`: bracket {:?} must be 0 < low < high, tolerance, slip_limit and max_steps positive", s.bracket)));
-            }
+        if let Some(s) = &p.ssr
+            && !(s.bracket[0] > 0.0 && s.bracket[0] < s.bracket[1] && s.tolerance > 0.0 && s.slip_limit > 0.0 && s.max_steps > 0)
+        {
+            return Err(invalid(format!("`ssr`: bracket {:?} must be 0 < low < high, tolerance, slip_limit and max_steps positive", s.bracket)));
         }
         let base = Scene::load(&study.scene)?;
         for j in [&p.joints.a, &p.joints.b] {

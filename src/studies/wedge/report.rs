@@ -354,7 +354,7 @@ pub struct LeTable {
     pub line_length: f64,
 }
 
-fn find<'a>(runs: &'a [WedgeRun], pred: impl Fn(&WedgeRunSpec) -> bool) -> Option<&'a WedgeRun> {
+fn find(runs: &[WedgeRun], pred: impl Fn(&WedgeRunSpec) -> bool) -> Option<&WedgeRun> {
     runs.iter().find(|r| pred(&r.spec))
 }
 
@@ -642,7 +642,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     );
     let recs = base.loads.base.iter().map(|b| format!("`{}` along ({}, {}, {}) × {}", b.record.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(), b.direction[0], b.direction[1], b.direction[2], b.pga.map(|p| format!("PGA {p} g")).or(b.scale.map(|s| format!("scale {s}"))).unwrap_or_else(|| "1".into()))).collect::<Vec<_>>().join("; ");
     let _ = writeln!(md, "- Base motion (base scene): {recs}. Every record is scaled by one factor so that the horizontal PGA takes the study values: by default the committed El Centro 1940 NS record horizontally (y, north) and 2/3 of the same record vertically (z), in phase. The seed used the Koyna record, which is not public.");
-    let _ = writeln!(md, "- Damping: {}. Duration {} s per run (record plus free vibration).\n", damping_text(&base), base.time.duration);
+    let _ = writeln!(md, "- Damping: {}. Duration {} s per run (record plus free vibration).\n", damping_text(base), base.time.duration);
 
     let _ = writeln!(md, "## Static factor of safety\n");
     let mut t = Table::new(["method", "geometry (what H = 39.624 m measures)", "FS"]);
