@@ -241,3 +241,28 @@ fn incline_study_plans_runs_with_make_and_reports_against_rigid_newmark() {
     assert!(!o.status.success() && err.contains("phi40-pga0.50") && err.contains("no results"), "{err}");
     assert!(std::fs::read_to_string(dir.join("out/report.md")).unwrap().contains("## Runs without results"));
 }
+
+#[test]
+fn history_table_reads_columns_by_name_and_names_what_is_wrong() {
+    // The typed history reader (src/output/history.rs): columns by name, `NaN` is a value; a
+    // missing column, a truncated row or a non-numeric cell is an error naming the file, the
+    // line and the column (never a 0 or a NaN filled in).
+    use jointquake::output::history::HistoryTable;
+    let dir = scratch("study/history");
+    let p = dir.join("h.csv");
+    std::fs::write(&p, "# monitor P1\nt,ux,open\n0,1e-3,4\n0.5,NaN,2\n").unwrap();
+    let h = HistoryTable::read(&p).unwrap();
+    assert_eq!(h.len(), 2);
+    assert_eq!(h.column("t").unwrap(), [0.0, 0.5]);
+    assert!(h.column("ux").unwrap()[1].is_nan());
+    let e = h.column("uy").unwrap_err().to_string();
+    assert!(e.contains("h.csv") && e.contains("`uy`") && e.contains("t, ux, open"), "{e}");
+    std::fs::write(&p, "t,ux,open\n0,1e-3,4\n0.5,2e-3\n").unwrap();
+    let e = HistoryTable::read(&p).unwrap_err().to_string();
+    assert!(e.contains("line 3") && e.contains("2 values for 3 columns"), "{e}");
+    std::fs::write(&p, "t,ux,open\n0,abc,4\n").unwrap();
+    let e = HistoryTable::read(&p).unwrap_err().to_string();
+    assert!(e.contains("line 2, column `ux`") && e.contains("abc"), "{e}");
+    std::fs::write(&p, "# nothing\n").unwrap();
+    assert!(HistoryTable::read(&p).unwrap_err().to_string().contains("no header"));
+}
