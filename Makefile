@@ -12,12 +12,14 @@ export GMSH
 BIN       := target/release/jointquake
 SCENE     ?= pipelines/wedge.json
 STUDY     ?= pipelines/wedge_study.json
+# The wedge study file whose kind draws the demo's charts (`study chart`).
+WEDGE_STUDY := pipelines/wedge_study.json
 # Parallel runs of `make wedge` (independent scenes, one thread each). Default: all cores.
 JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures wedge wedge3 wedge-report fuzz
+.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -48,7 +50,7 @@ demo: venv build
 	@echo
 	@echo "== the wedge at 1.0 g (El Centro NS + 2/3 vertical), node-to-segment contact"
 	@$(BIN) run pipelines/wedge.json --out out/demo
-	@$(BIN) study chart $(STUDY) --scene pipelines/wedge.json --run out/demo
+	@$(BIN) study chart $(WEDGE_STUDY) --scene pipelines/wedge.json --run out/demo
 	@$(PY) scripts/check_vtu.py out/demo --quiet
 	@echo
 	@echo "ParaView: open out/demo/wedge.pvd (the blocks) and out/demo/joints/A.pvd, B.pvd (joint surfaces: gap, slip, state),"
@@ -67,7 +69,7 @@ test: venv
 	$(PY) scripts/check_vtu.py target/test-column
 	@echo "== the demo's wedge scene (first 2 s) and its charts, cross-checked with meshio"
 	$(BIN) run pipelines/wedge.json --out target/test-demo --duration 2 --quiet
-	$(BIN) study chart $(STUDY) --scene pipelines/wedge.json --run target/test-demo
+	$(BIN) study chart $(WEDGE_STUDY) --scene pipelines/wedge.json --run target/test-demo
 	$(PY) scripts/check_vtu.py target/test-demo
 	@echo "== meshio cross-check of a scene with a joint (joint series, joint history)"
 	$(BIN) run pipelines/impact.json --out target/test-impact --quiet
@@ -81,25 +83,36 @@ mesh: venv build
 run: venv build
 	$(BIN) run $(SCENE)
 
-# The wedge study: plan (scenes, meshes, runs.mk), the runs and the strength reduction in
-# parallel ($(JOBS) at a time), then the report (out/wedge/report.md and charts/).
-wedge: venv build
-	$(BIN) study plan $(STUDY) --bin $(CURDIR)/$(BIN)
-	$(MAKE) --no-print-directory -j$(JOBS) -f out/wedge/runs.mk all
+# Any study (docs/studies.md): plan (scenes, meshes, runs.mk), its runs and steps in parallel
+# ($(JOBS) at a time; a run already done with an unchanged scene is not redone), then the
+# report (<out>/report.md, report.json, charts/). STUDY=pipelines/x_study.json.
+study: venv build
+	@mk=$$($(BIN) study plan $(STUDY) --bin $(CURDIR)/$(BIN) | tee /dev/stderr | sed -n 's/^  makefile  //p') && \
+	  $(MAKE) --no-print-directory -j$(JOBS) -f $$mk all
 	$(BIN) study report $(STUDY)
+
+# Only the report, from the runs already done.
+study-report: build
+	$(BIN) study report $(STUDY)
+
+# The wedge study (docs/wedge.md; out/wedge): 41 runs and the strength reduction.
+wedge:
+	$(MAKE) --no-print-directory study STUDY=pipelines/wedge_study.json
 
 # The same study with the three-component El Centro 1940 (PEER RSN6: 180 along y, 270 along x,
 # UP along z, scaled together) when ../shared/records is present (medium mesh only).
 EC3 := ../shared/records/elcentro1940_RSN6_ELC180.txt
-wedge3: venv build
+wedge3:
 	@if [ ! -f $(EC3) ]; then echo "make wedge3: $(EC3) is not here; this study needs the three-component El Centro records"; exit 1; fi
-	$(BIN) study plan pipelines/wedge_elcentro3_study.json --bin $(CURDIR)/$(BIN)
-	$(MAKE) --no-print-directory -j$(JOBS) -f out/wedge_elcentro3/runs.mk all
-	$(BIN) study report pipelines/wedge_elcentro3_study.json
+	$(MAKE) --no-print-directory study STUDY=pipelines/wedge_elcentro3_study.json
 
-# Only the report, from the runs already in out/wedge.
-wedge-report: build
-	$(BIN) study report $(STUDY)
+wedge-report:
+	$(MAKE) --no-print-directory study-report STUDY=pipelines/wedge_study.json
+
+# The El Centro incline (docs/studies.md): friction angle 35°/40° × PGA 0.25/0.5/0.75 g on the
+# committed incline fixture against the rigid Newmark block (6 runs of about 12 s; out/incline).
+incline:
+	$(MAKE) --no-print-directory study STUDY=pipelines/incline_study.json
 
 bench: build
 	cargo bench --bench explicit

@@ -30,6 +30,8 @@ pub enum Error {
     Rigid(#[from] crate::rigid::RigidError),
     #[error(transparent)]
     Report(#[from] ReportError),
+    #[error(transparent)]
+    Study(#[from] StudyError),
 }
 
 /// Reading a `.msh` file or looking up its parts.
@@ -113,6 +115,16 @@ pub enum InterfaceError {
     Invalid { joint: String, message: String },
     #[error(transparent)]
     Mesh(#[from] MeshError),
+}
+
+/// Loading a study file or planning its runs (the `study` module): names the study file and the
+/// field (or the run) to fix.
+#[derive(Debug, Error)]
+pub enum StudyError {
+    #[error("cannot read study file {path}: {message}")]
+    Io { path: PathBuf, message: String },
+    #[error("study {path}: {message}")]
+    Invalid { path: PathBuf, message: String },
 }
 
 /// Writing results.

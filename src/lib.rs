@@ -29,6 +29,8 @@
 //!   an anisotropic mass: `docs/contact.md`
 //! - errors (what the user must fix): [`error`]
 //! - charts (PNG + SVG) and Markdown tables for study reports: [`report`]
+//! - study files, run ids, the results layout: [`study`] (and `docs/studies.md`); what each
+//!   study adds (metrics, tables, charts): [`studies`]
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages, through the
 //! run object [`simulation::Simulation`], which strength reduction, the tests and the benchmarks
@@ -49,6 +51,7 @@ pub mod report;
 pub mod rigid;
 pub mod scene;
 pub mod simulation;
+pub mod studies;
 pub mod study;
 pub mod vtk;
 

@@ -124,18 +124,19 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
-    /// The wedge study of the seed paper: `plan`, `ssr`, `report`, `chart` (docs/wedge.md).
+    /// Studies: a base scene varied over axes, its runs in parallel with make, its report
+    /// (`plan`, `step`, `report`, `chart`; docs/studies.md).
     Study {
         #[command(subcommand)]
         action: StudyCmd,
     },
 }
 
-/// Stages of the wedge study (`pipelines/wedge_study.json`; docs/wedge.md).
+/// Stages of a study (a study file, docs/studies.md).
 #[derive(Subcommand)]
 enum StudyCmd {
-    /// Write the variant scenes, `plan.json` and the Makefile `runs.mk` of the study under its
-    /// output directory, and mesh every distinct geometry once.
+    /// Write the run scenes, `plan.json` and the Makefile `runs.mk` under the study's output
+    /// directory, and mesh every distinct geometry once.
     Plan {
         study: PathBuf,
         #[arg(long, default_value = "build/mesh")]
@@ -144,19 +145,22 @@ enum StudyCmd {
         #[arg(long, default_value = "target/release/jointquake")]
         bin: String,
     },
-    /// FEM strength reduction of the study's wedge (gravity only) → `<out>/ssr.json`.
-    Ssr {
+    /// Run a step of the study that is not a scene run (the wedge's `ssr`: FEM strength
+    /// reduction) and write its result file under the study's output directory.
+    Step {
         study: PathBuf,
+        /// The step's name (the plan lists the study's steps).
+        name: String,
         #[arg(long, default_value = "build/mesh")]
         cache: PathBuf,
         #[arg(long)]
         threads: Option<usize>,
     },
-    /// Read every run, add limit equilibrium and the rigid block, write `<out>/report.md`,
-    /// `report.json` and `charts/`.
+    /// Read every run and step, write `<out>/report.md`, `report.json` and `charts/`. Exits
+    /// with status 1 (after writing) when runs or steps have no results, naming them.
     Report { study: PathBuf },
-    /// Charts of one run of the study's wedge (slip at P2, P1 displacement, rigid block) in
-    /// `<run>/charts/`.
+    /// Charts of one run of the study's model in `<run>/charts/` (the wedge: slip at P2 with
+    /// the rigid block, P1 displacement).
     Chart {
         study: PathBuf,
         /// The scene that was run.
@@ -294,55 +298,59 @@ fn real_main() -> Result<()> {
 }
 
 fn study_cmd(action: StudyCmd) -> Result<()> {
-    use jointquake::study::{wedge, wedge_report};
-    let load = |p: &PathBuf| wedge::WedgeStudy::load(p).with_context(|| format!("loading study {}", p.display()));
+    use jointquake::study;
+    let load = |p: &PathBuf| jointquake::studies::load(p).with_context(|| format!("loading study {}", p.display()));
     match action {
-        StudyCmd::Plan { study, cache, bin } => {
-            let s = load(&study)?;
-            let files = wedge::write_plan(&study, &s, &cache, &bin).with_context(|| format!("planning study {}", study.display()))?;
-            say!("study {}: {} runs planned, {} meshes ready", s.name(), files.scenes.len(), files.meshes.len());
+        StudyCmd::Plan { study: path, cache, bin } => {
+            let (s, kind) = load(&path)?;
+            let files = study::write_plan(&s, &kind.steps(), &cache, &bin).with_context(|| format!("planning study {}", path.display()))?;
+            say!(
+                "study {} ({}): {} runs planned ({} scenes new or changed), {} steps, {} meshes ready",
+                s.name,
+                s.kind,
+                files.scenes.len(),
+                files.changed,
+                kind.steps().len(),
+                files.meshes.len()
+            );
             say!("  plan      {}", files.plan.display());
             say!("  makefile  {}", files.makefile.display());
         }
-        StudyCmd::Ssr { study, cache, threads } => {
+        StudyCmd::Step { study: path, name, cache, threads } => {
             let threads = threads.map(capped_threads).transpose()?;
             if let Some(n) = threads {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
             }
-            let s = load(&study)?;
-            let r = wedge::run_ssr(&s, &cache).with_context(|| format!("strength reduction of study {}", study.display()))?;
-            let out = s.out_dir();
-            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-            let p = out.join("ssr.json");
-            std::fs::write(&p, serde_json::to_string_pretty(&r).context("serialising the strength reduction")?).with_context(|| format!("writing {}", p.display()))?;
-            say!(
-                "strength reduction ({} mesh, {} elements): F = {:.4} (bracket {:.4}–{:.4}); limit equilibrium {:.4} → {:+.1} %",
-                r.mesh, r.elements, r.result.factor, r.result.bracket[0], r.result.bracket[1], r.le_fs, 100.0 * (r.result.factor / r.le_fs - 1.0)
-            );
-            for t in &r.result.trials {
-                say!(
-                    "  F = {:.4}: {} (steps {}, residual {:.1e}, max slip {:.3e} m, |u| P1 {:.3e} m)",
-                    t.factor, if t.failed { "fails" } else { "stable" }, t.steps, t.residual, t.max_slip, t.monitor_displacement
-                );
+            let (s, kind) = load(&path)?;
+            let opts = study::StepOptions { mesh_cache: cache };
+            let (p, out) = study::run_step(&s, kind.as_ref(), &name, &opts).with_context(|| format!("step {name} of study {}", path.display()))?;
+            for l in &out.lines {
+                say!("{l}");
             }
-            say!("  written {} in {:.1} s", p.display(), r.wall_time);
+            say!("  written {}", p.display());
         }
-        StudyCmd::Report { study } => {
-            let s = load(&study)?;
-            let r = wedge_report::write_report(&s).with_context(|| format!("report of study {}", study.display()))?;
-            say!("wedge study report: {}", r.report.display());
+        StudyCmd::Report { study: path } => {
+            let (s, kind) = load(&path)?;
+            let r = study::write_report(&s, kind.as_ref()).with_context(|| format!("report of study {}", path.display()))?;
+            say!("study {} report: {}", s.name, r.report.display());
             for c in &r.charts {
                 say!("  chart {} (and .svg)", c.display());
             }
-            for t in &r.trend {
+            for t in &r.lines {
                 say!("  {t}");
             }
+            if !r.problems.is_empty() {
+                let list = r.problems.iter().map(|(id, why)| format!("  {id}: {why}")).collect::<Vec<_>>().join("\n");
+                anyhow::bail!("the report is written, but {} run(s) or step(s) have no results (listed in it); `make -f {} all` runs them:\n{list}", r.problems.len(), s.out.join("runs.mk").display());
+            }
         }
-        StudyCmd::Chart { study, scene, run } => {
-            let s = load(&study)?;
-            let (charts, slip) = wedge_report::write_run_charts(&s, &scene, &run).with_context(|| format!("charts of run {}", run.display()))?;
-            say!("residual slip at P2: {slip:.4} m");
-            for c in &charts {
+        StudyCmd::Chart { study: path, scene, run } => {
+            let (s, kind) = load(&path)?;
+            let r = kind.run_charts(&s, &scene, &run).with_context(|| format!("charts of run {}", run.display()))?;
+            for l in &r.lines {
+                say!("{l}");
+            }
+            for c in &r.charts {
                 say!("  chart {} (and .svg)", c.display());
             }
         }

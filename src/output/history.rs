@@ -62,3 +62,69 @@ impl HistoryWriter {
         self.files.iter().map(|(p, _)| p.clone()).collect()
     }
 }
+
+/// A CSV history read back by column name: the monitor histories of [`HistoryWriter`] and
+/// the joint histories of [`super::joints`] (`#` comment lines, one header line of column
+/// names, then rows of numbers; `NaN` is a number). Every row must have one value per
+/// column: a truncated or non-numeric cell is an error naming the file, line and column.
+#[derive(Clone, Debug)]
+pub struct HistoryTable {
+    pub path: PathBuf,
+    /// Column names in file order.
+    pub columns: Vec<String>,
+    /// Values column by column (`data[c][row]`).
+    data: Vec<Vec<f64>>,
+}
+
+impl HistoryTable {
+    /// Read a history file written by this module or by the joint writer.
+    pub fn read(path: &Path) -> Result<HistoryTable, OutputError> {
+        let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
+        let mut columns: Option<Vec<String>> = None;
+        let mut data: Vec<Vec<f64>> = Vec::new();
+        for (ln, line) in text.lines().enumerate() {
+            if line.starts_with('#') || line.trim().is_empty() {
+                continue;
+            }
+            let Some(cols) = &columns else {
+                let c: Vec<String> = line.split(',').map(|s| s.trim().to_string()).collect();
+                data = vec![Vec::new(); c.len()];
+                columns = Some(c);
+                continue;
+            };
+            let cells: Vec<&str> = line.split(',').collect();
+            if cells.len() != cols.len() {
+                return Err(OutputError::read(path, format!("line {}: {} values for {} columns (a truncated row?)", ln + 1, cells.len(), cols.len())));
+            }
+            for (c, cell) in cells.iter().enumerate() {
+                let v = cell.trim().parse::<f64>().map_err(|e| OutputError::read(path, format!("line {}, column `{}`: `{cell}`: {e}", ln + 1, cols[c])))?;
+                data[c].push(v);
+            }
+        }
+        let columns = columns.ok_or_else(|| OutputError::read(path, "no header line (an empty history)"))?;
+        Ok(HistoryTable { path: path.to_path_buf(), columns, data })
+    }
+
+    /// Number of rows.
+    pub fn len(&self) -> usize {
+        self.data.first().map_or(0, |c| c.len())
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The values of column `name`; an error naming the file and the columns it has if absent.
+    pub fn column(&self, name: &str) -> Result<&[f64], OutputError> {
+        let i = self.columns.iter().position(|c| c == name).ok_or_else(|| {
+            OutputError::read(&self.path, format!("no column `{name}` (columns: {})", self.columns.join(", ")))
+        })?;
+        Ok(&self.data[i])
+    }
+
+    /// Three columns as vectors, e.g. `["ux", "uy", "uz"]`.
+    pub fn vectors(&self, names: [&str; 3]) -> Result<Vec<[f64; 3]>, OutputError> {
+        let (a, b, c) = (self.column(names[0])?, self.column(names[1])?, self.column(names[2])?);
+        Ok((0..self.len()).map(|i| [a[i], b[i], c[i]]).collect())
+    }
+}

@@ -13,6 +13,7 @@ mod mesh;
 mod outputs;
 mod report;
 mod rigid;
+mod study;
 mod tagging;
 mod wedge;
 mod wedge_mechanism;

@@ -369,7 +369,7 @@ fn every_committed_scene_loads() {
         if p.extension().is_some_and(|x| x == "json") {
             if p.file_stem().is_some_and(|s| s.to_string_lossy().ends_with("_study")) {
                 // a study file (pipelines/wedge_study.json) names a scene; it must load and so must its scene
-                let st = jointquake::study::wedge::WedgeStudy::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+                let (st, _) = jointquake::studies::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
                 jointquake::scene::Scene::load(&st.scene).unwrap_or_else(|e| panic!("{}: {e}", st.scene.display()));
             } else {
                 jointquake::scene::Scene::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));

@@ -9,8 +9,8 @@ use jointquake::interface::{tag_joint, JointSpec};
 use jointquake::mesh::Mesh;
 use jointquake::rigid::wedge::{analyse_wedge, wedge_seismic_coeffs, WedgeInput};
 use jointquake::study::ssr::{strength_reduction, SsrOptions};
-use jointquake::study::wedge::{plan_runs, WedgeStudy};
-use jointquake::study::wedge_report::read_point_history;
+use jointquake::studies::wedge::report::PointHistory;
+use jointquake::study::{plan_runs, Study};
 use serde_json::{json, Value};
 
 fn rel(a: f64, b: f64) -> f64 {
@@ -150,7 +150,7 @@ fn wedge_seismic_run_slides_only_above_the_critical_acceleration() {
         std::fs::write(&sp, serde_json::to_string_pretty(&v).unwrap()).unwrap();
         let opts = jointquake::pipeline::RunOptions { out_dir: Some(dir.join(format!("out{factor}"))), ..Default::default() };
         jointquake::pipeline::run(&sp, &opts).unwrap();
-        let h = |n: &str| read_point_history(&dir.join(format!("out{factor}/histories/{n}.csv"))).unwrap();
+        let h = |n: &str| PointHistory::read(&dir.join(format!("out{factor}/histories/{n}.csv"))).unwrap();
         let (w, r) = (h("P2w"), h("P2r"));
         let e = jointquake::rigid::wedge::build_wedge(&WedgeInput::default()).unwrap().e;
         let s = |i: usize| (0..3).map(|k| (w.u[i][k] - r.u[i][k]) * e[k]).sum::<f64>();
@@ -168,20 +168,27 @@ fn wedge_seismic_run_slides_only_above_the_critical_acceleration() {
 fn wedge_study_plans_every_level_once_and_the_expensive_runs_first() {
     // The committed study file: 5 PGAs × (NTS, NTN) on coarse and medium, the fine NTS-L2
     // reference at every PGA, and at 1.0 g fine NTS-L1 and NTN, NTS-L2 on coarse and medium,
-    // E × 0.5 and × 2; the medium sweep again on a rigid rock: 41 runs, no duplicates, fine first.
-    let study = WedgeStudy::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge_study.json"))).unwrap();
-    let runs = plan_runs(&study);
+    // E × 0.5 and × 2; the medium sweep again on the elastic rock: 41 runs, no duplicates,
+    // fine first, one run with frames (the medium NTS-L1 run at 1.0 g, to look at in ParaView).
+    let (study, kind) = jointquake::studies::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge_study.json"))).unwrap();
+    let runs = plan_runs(&study).unwrap();
     let mut ids: Vec<&str> = runs.iter().map(|r| r.id.as_str()).collect();
     assert_eq!(runs.len(), 5 * 2 * 2 + 5 + 2 + 2 + 2 + 5 * 2, "{ids:?}");
-    assert!(runs.iter().take(7).all(|r| r.mesh == "fine"));
-    assert_eq!(runs.iter().filter(|r| r.frames).count(), 1);
+    assert!(runs.iter().take(7).all(|r| r.label("mesh") == Some("fine")), "{ids:?}");
+    let frames: Vec<&str> = runs.iter().filter(|r| r.overrides.iter().any(|o| o.scene.get("/output/frames") == Some(&json!(true)))).map(|r| r.id.as_str()).collect();
+    assert_eq!(frames, ["nts1-medium-pga1.00-rigidrock"]);
+    assert!(ids.contains(&"nts1-medium-pga1.00-E0.5-rigidrock") && ids.contains(&"ntn-medium-pga0.20-elasticrock"), "{ids:?}");
     ids.sort();
     ids.dedup();
     assert_eq!(ids.len(), runs.len());
-    // a study naming an unknown mesh level is refused, naming it
+    // the strength reduction is a step of the study
+    assert_eq!(kind.steps().iter().map(|s| s.name.as_str()).collect::<Vec<_>>(), ["ssr"]);
+    // a wedge study naming a mesh level that its mesh axis does not have is refused, naming it
     let dir = scratch("wedge/study_bad");
     let p = dir.join("s.json");
-    std::fs::write(&p, r#"{"scene": "x.json", "meshes": [{"name": "a", "set": {}}], "sweep_mesh": "b"}"#).unwrap();
-    let e = WedgeStudy::load(&p).unwrap_err().to_string();
-    assert!(e.contains("\"b\"") && e.contains("a"), "{e}");
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge_study.json")).unwrap().replace("\"sweep_mesh\": \"medium\"", "\"sweep_mesh\": \"mediun\"");
+    std::fs::write(&p, text.replace("\"scene\": \"wedge.json\"", &format!("\"scene\": {:?}", concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge.json")))).unwrap();
+    let e = jointquake::studies::load(&p).err().expect("refused").to_string();
+    assert!(e.contains("\"mediun\"") && e.contains("coarse, medium, fine") && e.contains("s.json"), "{e}");
+    let _ = Study::load(&p).unwrap(); // the engine itself accepts it: only the wedge kind needs the level
 }

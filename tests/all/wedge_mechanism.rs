@@ -12,7 +12,7 @@ use jointquake::dynamics::loads::{base_motions, ground_acceleration_of};
 use jointquake::output::joints::{read_joint_forces, JointForcesRow};
 use jointquake::rigid::wedge::{analyse_wedge, build_wedge, wedge_seismic_coeffs, WedgeInput};
 use jointquake::scene::Scene;
-use jointquake::study::wedge_report::read_point_history;
+use jointquake::studies::wedge::report::PointHistory;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 
@@ -61,7 +61,7 @@ fn run_wedge(dir: &Path, name: &str, record: &Path, e_wedge: f64, duration: f64)
 
 /// Residual slip at P2 down the line of intersection [m] (as the wedge study defines it).
 fn p2_slip(out: &Path) -> f64 {
-    let h = |n: &str| read_point_history(&out.join(format!("histories/{n}.csv"))).unwrap();
+    let h = |n: &str| PointHistory::read(&out.join(format!("histories/{n}.csv"))).unwrap();
     let (w, r) = (h("P2w"), h("P2r"));
     let e = build_wedge(&WedgeInput::default()).unwrap().e;
     let s = |i: usize| (0..3).map(|k| (w.u[i][k] - r.u[i][k]) * e[k]).sum::<f64>();

@@ -1,6 +1,6 @@
-//! The wedge study's report: reads the runs of [`super::wedge::Plan`], adds the rigid-block and
-//! limit-equilibrium levels, and writes `<out>/report.md`, `<out>/report.json` and the charts
-//! (`<out>/charts/*.png` and `.svg`).
+//! The wedge study's metrics, tables and charts: reads the runs through the engine's typed
+//! results ([`crate::study::StudyResults`]), adds the rigid-block and limit-equilibrium levels,
+//! and returns the Markdown and JSON of the report; charts go to `<out>/charts/*.png` and `.svg`.
 //!
 //! Quantities (SI; slip and displacements in m, times in s):
 //! - residual slip: relative displacement of the wedge and rock nodes at P2 along the line of
@@ -14,16 +14,18 @@
 //!   is added when the slip exceeds 10 % of the line of intersection (the wedge has moved out
 //!   of its bed: contact area and support are no longer those of limit equilibrium).
 
-use super::rigid_level::{rigid_wedge_slip, sample_ground_motion, Bond, RigidWedgeRun};
-use super::wedge::{variant_scene, Plan, RunSpec, StudySsr, WedgeStudy};
+use super::{StudySsr, WedgeKind};
 use crate::dynamics::loads::base_motions;
-use crate::error::{Error, ModelError, OutputError};
+use crate::error::{Error, OutputError};
+use crate::output::history::HistoryTable;
 use crate::report::{fmt_percent, fmt_sig, pareto_front, Axis, Chart, Series, Table};
 use crate::rigid::wedge::{analyse_wedge, build_wedge, HeightDef, WedgeInput};
 use crate::scene::Scene;
+use crate::study::rigid_level::{rigid_wedge_slip, sample_ground_motion, Bond, RigidWedgeRun};
+use crate::study::{scene_for, KindReport, RunCharts, RunResult, StudyResults, Variation};
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// A monitored point's history: time, displacement and acceleration (relative to the base).
 #[derive(Clone, Debug, Default)]
@@ -33,40 +35,23 @@ pub struct PointHistory {
     pub a: Vec<[f64; 3]>,
 }
 
-/// Read a history CSV written by [`crate::output::history`] (`#` header, then
-/// `t,ux,uy,uz,...`): time and the three displacement columns.
-pub fn read_point_history(path: &Path) -> Result<PointHistory, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
-    let mut h = PointHistory::default();
-    let mut header_seen = false;
-    for (ln, line) in text.lines().enumerate() {
-        if line.starts_with('#') || line.trim().is_empty() {
-            continue;
+impl PointHistory {
+    /// The columns `t`, `ux..uz`, `ax..az` of a monitor history, by name.
+    pub fn from_table(h: &HistoryTable) -> Result<PointHistory, OutputError> {
+        if h.is_empty() {
+            return Err(OutputError::read(&h.path, "no history rows (did the run stop before its first step?)"));
         }
-        if !header_seen {
-            header_seen = true;
-            if !line.starts_with("t,ux,uy,uz") {
-                return Err(ModelError::Invalid(format!("{}: line {}: expected the header `t,ux,uy,uz,...`, found `{line}`", path.display(), ln + 1)).into());
-            }
-            continue;
-        }
-        let v: Vec<f64> = line.split(',').take(10).map(|x| x.trim().parse::<f64>()).collect::<Result<_, _>>().map_err(|e| {
-            ModelError::Invalid(format!("{}: line {}: {e} in `{line}`", path.display(), ln + 1))
-        })?;
-        if v.len() < 10 {
-            return Err(ModelError::Invalid(format!("{}: line {}: fewer than 10 columns (t, u, v, a)", path.display(), ln + 1)).into());
-        }
-        h.t.push(v[0]);
-        h.u.push([v[1], v[2], v[3]]);
-        h.a.push([v[7], v[8], v[9]]);
+        Ok(PointHistory { t: h.column("t")?.to_vec(), u: h.vectors(["ux", "uy", "uz"])?, a: h.vectors(["ax", "ay", "az"])? })
     }
-    if h.t.is_empty() {
-        return Err(ModelError::Invalid(format!("{}: no history rows (did the run stop before its first step?)", path.display())).into());
+
+    /// Read a monitor history file (`histories/<name>.csv`).
+    pub fn read(path: &Path) -> Result<PointHistory, OutputError> {
+        PointHistory::from_table(&HistoryTable::read(path)?)
     }
-    Ok(h)
 }
 
-/// Per-sample counts of a joint history CSV (`t,...,open,stick,slip,bonded,...`).
+/// Per-sample counts of a joint history (columns `t`, `open`, `stick`, `slip`, `bonded`,
+/// `max_opening`).
 #[derive(Clone, Debug, Default)]
 pub struct JointCounts {
     pub t: Vec<f64>,
@@ -75,39 +60,76 @@ pub struct JointCounts {
     pub max_opening: f64,
 }
 
-fn read_joint_counts(path: &Path) -> Result<JointCounts, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
-    let mut lines = text.lines().filter(|l| !l.starts_with('#') && !l.trim().is_empty());
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &str| {
-        header.iter().position(|h| *h == name).ok_or_else(|| ModelError::Invalid(format!("{}: no column `{name}`", path.display())))
-    };
-    let (ci, co, cs, cl, cb, cm) = (col("t")?, col("open")?, col("stick")?, col("slip")?, col("bonded")?, col("max_opening")?);
-    let mut c = JointCounts::default();
-    for line in lines {
-        let v: Vec<&str> = line.split(',').collect();
-        let num = |i: usize| v.get(i).and_then(|x| x.trim().parse::<f64>().ok()).unwrap_or(f64::NAN);
-        c.t.push(num(ci));
-        c.open.push(num(co) as u32);
-        c.in_contact.push((num(cs) + num(cl) + num(cb)) as u32);
-        c.max_opening = c.max_opening.max(num(cm));
+fn joint_counts(h: &HistoryTable) -> Result<JointCounts, OutputError> {
+    let (t, open, stick, slip, bonded, mo) = (h.column("t")?, h.column("open")?, h.column("stick")?, h.column("slip")?, h.column("bonded")?, h.column("max_opening")?);
+    Ok(JointCounts {
+        t: t.to_vec(),
+        open: open.iter().map(|&x| x as u32).collect(),
+        in_contact: (0..h.len()).map(|i| (stick[i] + slip[i] + bonded[i]) as u32).collect(),
+        max_opening: mo.iter().copied().fold(0.0, f64::max),
+    })
+}
+
+/// What a FEM run of the wedge study is, read from its scene and its labels (see the module
+/// doc of [`super`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct WedgeRunSpec {
+    pub id: String,
+    /// Label on the mesh axis.
+    pub mesh: String,
+    /// Contact method of its joints ("nts", "ntn", "penalty") and candidate layer.
+    pub method: String,
+    pub layer: u8,
+    /// Horizontal PGA [g].
+    pub pga: f64,
+    /// Factor on the Young's modulus (run scene over base scene).
+    pub e_factor: f64,
+    /// Rock nodes fixed (FEM wedge on a rigid rock).
+    pub rigid_rock: bool,
+}
+
+impl WedgeRunSpec {
+    /// Short label of the model level, e.g. "NTS-L1 medium".
+    pub fn level(&self) -> String {
+        let m = if self.method == "nts" { format!("NTS-L{}", self.layer) } else { self.method.to_uppercase() };
+        format!("{m} {}", self.mesh)
     }
-    Ok(c)
+
+    fn of(kind: &WedgeKind, run: &RunResult, base: &Scene) -> Result<WedgeRunSpec, String> {
+        let scene = run.scene.as_ref().ok_or("its scene cannot be read")?;
+        let mesh = run.spec.label(&kind.params.mesh_axis).ok_or_else(|| format!("no label on the mesh axis \"{}\"", kind.params.mesh_axis))?.to_string();
+        let pga = run.spec.pga.ok_or("the run sets no `pga`")?;
+        let j = scene.joints.first().ok_or("its scene has no joints")?;
+        let e0 = base.materials.first().map(|m| m.e).ok_or("the base scene has no material")?;
+        let e = scene.materials.first().map(|m| m.e).ok_or("its scene has no material")?;
+        let weighted = scene.loads.gravity.as_ref().and_then(|g| g.groups.clone()).unwrap_or_default();
+        let rock: Vec<&str> = scene.materials.iter().filter(|m| !weighted.contains(&m.group)).map(|m| m.group.as_str()).collect();
+        Ok(WedgeRunSpec {
+            id: run.spec.id.clone(),
+            mesh,
+            method: j.method().as_str().to_string(),
+            layer: j.layer.unwrap_or(1),
+            pga,
+            e_factor: e / e0,
+            rigid_rock: scene.boundary.iter().any(|b| rock.contains(&b.group.as_str())),
+        })
+    }
 }
 
 /// The outcome of one FEM run, as the report uses it.
 #[derive(Clone, Debug, Serialize)]
-pub struct RunResult {
-    pub spec: RunSpec,
+pub struct WedgeRun {
+    pub spec: WedgeRunSpec,
     pub level: String,
     /// The error that stopped the run (its histories end there), if any.
     pub failed: Option<String>,
-    pub nodes: usize,
-    pub elements: usize,
-    pub dt: f64,
-    pub steps: usize,
+    /// Size, step and cost from the run's summary (none for a failed run).
+    pub nodes: Option<usize>,
+    pub elements: Option<usize>,
+    pub dt: Option<f64>,
+    pub steps: Option<usize>,
     /// Wall time of the whole run (mesh read, model, equilibrium, dynamics) on one thread [s].
-    pub wall_time: f64,
+    pub wall_time: Option<f64>,
     pub residual_slip: f64,
     pub max_slip: f64,
     pub p1_residual: [f64; 3],
@@ -115,8 +137,9 @@ pub struct RunResult {
     pub mode: String,
     /// Largest joint opening of each joint [m] (name, value).
     pub max_opening: Vec<(String, f64)>,
-    /// Slave node-steps that found no master face (search event `lost`), per joint.
-    pub lost_node_steps: Vec<(String, u64)>,
+    /// Slave node-steps that found no master face (search event `lost`), per joint (from the
+    /// summary: none for a failed run).
+    pub lost_node_steps: Vec<(String, Option<u64>)>,
     /// Peak absolute acceleration of the rock monitor (x, y, z) [g], if the scene has it: the
     /// motion the rock delivers under the wedge, to compare with the PGA.
     pub rock_peak_accel: Option<[f64; 3]>,
@@ -155,7 +178,7 @@ fn thin<T: Copy>(v: &[T], max: usize) -> Vec<T> {
     out
 }
 
-fn classify_mode(slip: &[(f64, f64)], joints: &[(String, JointCounts, usize)], residual: f64, line_length: f64) -> String {
+fn classify_mode(slip: &[(f64, f64)], joints: &[(String, JointCounts)], residual: f64, line_length: f64) -> String {
     if residual.abs() < 0.01 {
         return "none".into();
     }
@@ -168,9 +191,9 @@ fn classify_mode(slip: &[(f64, f64)], joints: &[(String, JointCounts, usize)], r
     let nslide = sliding.iter().filter(|&&s| s).count().max(1);
     let fully_open = |c: &JointCounts, i: usize| c.in_contact.get(i).is_some_and(|&k| k == 0);
     let mut both_open = 0;
-    let m = joints.iter().map(|(_, c, _)| c.t.len()).min().unwrap_or(0);
+    let m = joints.iter().map(|(_, c)| c.t.len()).min().unwrap_or(0);
     for i in 0..m {
-        if joints.iter().all(|(_, c, _)| fully_open(c, i)) {
+        if joints.iter().all(|(_, c)| fully_open(c, i)) {
             both_open += 1;
         }
     }
@@ -178,7 +201,7 @@ fn classify_mode(slip: &[(f64, f64)], joints: &[(String, JointCounts, usize)], r
         "lift-off".to_string()
     } else {
         let mut one = None;
-        for (k, (name, c, _)) in joints.iter().enumerate() {
+        for (k, (name, c)) in joints.iter().enumerate() {
             let open_sliding = (0..n.min(c.t.len())).filter(|&i| sliding[i] && fully_open(c, i)).count();
             if open_sliding as f64 > 0.2 * nslide as f64 {
                 let other = joints.iter().enumerate().find(|(o, _)| *o != k).map(|(_, j)| j.0.clone()).unwrap_or_default();
@@ -193,20 +216,15 @@ fn classify_mode(slip: &[(f64, f64)], joints: &[(String, JointCounts, usize)], r
     mode
 }
 
-/// Read one run's results from `<out>/runs/<id>/`.
-pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], line_length: f64) -> Result<RunResult, Error> {
-    let dir = out.join("runs").join(&spec.id);
-    let sp = dir.join("summary.json");
-    let text = std::fs::read_to_string(&sp).map_err(|e| OutputError::read(&sp, e))?;
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| ModelError::Invalid(format!("{}: {e}", sp.display())))?;
-    let failed = std::fs::read_to_string(dir.join("failed.txt")).ok().map(|t| t.trim().to_string());
-    let f = |k: &str| v[k].as_f64().unwrap_or(f64::NAN);
-    let hist = |name: &str| read_point_history(&dir.join("histories").join(format!("{name}.csv")));
-    let (w, r, p1) = (hist(&study.monitors.p2_wedge)?, hist(&study.monitors.p2_rock)?, hist(&study.monitors.p1)?);
+/// Read one run's results (finished, or failed with its histories up to the error).
+fn read_run(kind: &WedgeKind, res: &RunResult, base: &Scene, e: [f64; 3], line_length: f64) -> Result<WedgeRun, Error> {
+    let spec = WedgeRunSpec::of(kind, res, base).map_err(|m| OutputError::read(&res.dir, m))?;
+    let mons = &kind.params.monitors;
+    let hist = |name: &str| -> Result<PointHistory, OutputError> { PointHistory::from_table(&res.history(name)?) };
+    let (w, r, p1) = (hist(&mons.p2_wedge)?, hist(&mons.p2_rock)?, hist(&mons.p1)?);
     let slip = slip_series(&w, &r, e);
-    let residual = slip.last().map(|s| s.1).unwrap_or(0.0);
+    let (residual, t_end) = slip.last().map(|s| (s.1, s.0)).expect("non-empty history");
     let max_slip = slip.iter().map(|s| s.1.abs()).fold(0.0, f64::max);
-    let t_end = slip.last().map(|s| s.0).unwrap_or(0.0);
     let still_sliding = slip.iter().find(|s| s.0 >= t_end - 0.5).map(|s0| {
         let dt = t_end - s0.0;
         dt > 0.0 && ((residual - s0.1) / dt).abs() > 1e-3
@@ -217,39 +235,25 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
     let mut joints = Vec::new();
     let mut max_opening = Vec::new();
     let mut lost = Vec::new();
-    // joint names: from the summary, or (a failed run has none) from the joint histories
-    let names: Vec<(String, u64, Option<f64>, usize)> = match v["joints"].as_array() {
-        Some(js) => js
-            .iter()
-            .map(|j| (j["name"].as_str().unwrap_or("?").to_string(), j["events"]["lost"].as_u64().unwrap_or(0), j["max_opening"].as_f64(), j["slave_nodes"].as_u64().unwrap_or(0) as usize))
-            .collect(),
-        None => {
-            let mut n: Vec<(String, u64, Option<f64>, usize)> = std::fs::read_dir(dir.join("histories"))
-                .map(|rd| {
-                    rd.filter_map(|e| e.ok())
-                        .filter_map(|e| e.file_name().to_str().and_then(|f| f.strip_prefix("joint_")).and_then(|f| f.strip_suffix(".csv")).map(|f| f.to_string()))
-                        .map(|name| (name, 0, None, 0))
-                        .collect()
-                })
-                .unwrap_or_default();
-            n.sort_by(|a, b| a.0.cmp(&b.0));
-            n
-        }
+    // the joints: from the summary of a finished run, else (a failed run has none) the scene's
+    let scene = res.scene.as_ref().expect("a run with a spec has its scene");
+    let names: Vec<String> = match &res.summary {
+        Some(s) => s.joints.iter().map(|j| j.name.clone()).collect(),
+        None => scene.joints.iter().map(|j| j.name.clone()).collect(),
     };
-    for (name, l, mo, n) in names {
-        let c = read_joint_counts(&dir.join("histories").join(format!("joint_{name}.csv")))?;
-        max_opening.push((name.clone(), mo.unwrap_or(c.max_opening)));
-        lost.push((name.clone(), l));
-        joints.push((name, c, n));
+    for name in names {
+        let c = joint_counts(&res.joint_history(&name)?)?;
+        let peaks = res.summary.as_ref().and_then(|s| s.joints.iter().find(|j| j.name == name));
+        max_opening.push((name.clone(), peaks.map_or(c.max_opening, |j| j.max_opening)));
+        lost.push((name.clone(), peaks.map(|j| j.events.lost)));
+        joints.push((name, c));
     }
     let mode = classify_mode(&slip, &joints, residual, line_length);
     // the rock's own motion under the wedge (absolute = relative + ground)
     let (mut rock_peak_accel, mut rigid_on_rock_slip) = (None, None);
-    let rock_csv = dir.join("histories").join(format!("{}.csv", study.monitors.rock));
-    if rock_csv.exists() {
-        let rh = read_point_history(&rock_csv)?;
-        let scene = Scene::load(&out.join("scenes").join(format!("{}.json", spec.id)))?;
-        let (motions, _) = base_motions(&scene)?;
+    if scene.output.monitor.iter().any(|m| m.name == mons.rock) {
+        let rh = hist(&mons.rock)?;
+        let (motions, _) = base_motions(scene)?;
         let abs: Vec<[f64; 3]> = rh
             .t
             .iter()
@@ -268,21 +272,23 @@ pub fn read_run(out: &Path, spec: &RunSpec, study: &WedgeStudy, e: [f64; 3], lin
         rock_peak_accel = Some(pk);
         if rh.t.len() > 2 {
             let dt = rh.t[1] - rh.t[0];
-            if let Ok(r) = rigid_wedge_slip(&study.wedge_of(&scene), &abs, dt, Bond::Brittle, false) {
+            // a wedge that the rock's motion lifts off its planes has no rigid-block answer
+            if let Ok(r) = rigid_wedge_slip(&kind.wedge_of(scene), &abs, dt, Bond::Brittle, false) {
                 rigid_on_rock_slip = Some(r.result.residual_displacement);
             }
         }
     }
     let p1_h: Vec<(f64, [f64; 3])> = p1.t.iter().zip(&p1.u).map(|(&t, u)| (t, [u[0] - u0[0], u[1] - u0[1], u[2] - u0[2]])).collect();
-    Ok(RunResult {
-        spec: spec.clone(),
+    let s = res.summary.as_ref();
+    Ok(WedgeRun {
         level: spec.level(),
-        failed,
-        nodes: v["nodes"].as_u64().unwrap_or(0) as usize,
-        elements: v["elements"].as_u64().unwrap_or(0) as usize,
-        dt: f("dt"),
-        steps: v["steps"].as_u64().unwrap_or(0) as usize,
-        wall_time: f("wall_time"),
+        spec,
+        failed: res.failed().map(str::to_string),
+        nodes: s.map(|s| s.nodes),
+        elements: s.map(|s| s.elements),
+        dt: s.map(|s| s.dt),
+        steps: s.map(|s| s.steps),
+        wall_time: s.map(|s| s.wall_time),
         residual_slip: residual,
         max_slip,
         p1_residual,
@@ -307,24 +313,18 @@ pub struct RigidAtPga {
     pub wall_time: f64,
 }
 
-fn rigid_at(base: &Scene, study: &WedgeStudy, pga: f64) -> Result<RigidAtPga, Error> {
-    let spec = RunSpec {
-        id: "rigid".into(),
-        mesh: study.meshes[0].name.clone(),
-        method: "nts".into(),
-        layer: 1,
-        pga,
-        e_factor: 1.0,
-        rigid_rock: false,
-        frames: false,
-        cost_rank: 0,
+/// The rigid level at one PGA: the scene of the study at that PGA (the other axes at their
+/// first value: the rigid level reads only the records, the duration and the joints).
+fn rigid_at(kind: &WedgeKind, results: &StudyResults, pga: f64, label: Option<&str>) -> Result<RigidAtPga, Error> {
+    let scene = match label {
+        Some(l) => scene_for(results.study, &results.base, &[(kind.params.pga_axis.as_str(), l)], &[], "rigid")?,
+        None => scene_for(results.study, &results.base, &[], &[Variation { pga: Some(pga), ..Default::default() }], "rigid")?,
     };
-    let scene = variant_scene(base, study, &spec)?;
     let (motions, _) = base_motions(&scene)?;
     let dt = motions.iter().map(|b| b.record.dt).fold(f64::INFINITY, f64::min);
     let t0 = std::time::Instant::now();
     let a = sample_ground_motion(&motions, dt, scene.time.duration);
-    let wedge = study.wedge_of(&scene);
+    let wedge = kind.wedge_of(&scene);
     let brittle = rigid_wedge_slip(&wedge, &a, dt, Bond::Brittle, true)?;
     let wall_time = t0.elapsed().as_secs_f64();
     let kept = rigid_wedge_slip(&wedge, &a, dt, Bond::Kept, true)?;
@@ -336,13 +336,11 @@ fn rigid_at(base: &Scene, study: &WedgeStudy, pga: f64) -> Result<RigidAtPga, Er
 pub struct WedgeReport {
     pub le: LeTable,
     pub ssr: Option<StudySsr>,
-    pub runs: Vec<RunResult>,
+    pub runs: Vec<WedgeRun>,
     pub rigid: Vec<RigidAtPga>,
     /// For each PGA: the cheapest level within `enough` of the reference slip.
     pub cheapest: Vec<(f64, String, f64, f64)>,
     pub trend: Vec<String>,
-    pub charts: Vec<PathBuf>,
-    pub report: PathBuf,
 }
 
 /// Limit-equilibrium numbers of the report.
@@ -356,7 +354,7 @@ pub struct LeTable {
     pub line_length: f64,
 }
 
-fn find<'a>(runs: &'a [RunResult], pred: impl Fn(&RunSpec) -> bool) -> Option<&'a RunResult> {
+fn find(runs: &[WedgeRun], pred: impl Fn(&WedgeRunSpec) -> bool) -> Option<&WedgeRun> {
     runs.iter().find(|r| pred(&r.spec))
 }
 
@@ -364,43 +362,56 @@ fn m(x: f64) -> String {
     fmt_sig(x, 4)
 }
 
-/// Write the report of a planned and run study.
-pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
-    let out = study.out_dir();
-    let plan_path = out.join("plan.json");
-    let plan: Plan = serde_json::from_str(&std::fs::read_to_string(&plan_path).map_err(|e| OutputError::read(&plan_path, e))?)
-        .map_err(|e| ModelError::Invalid(format!("{}: {e} (re-run `jointquake study plan`)", plan_path.display())))?;
-    let base = Scene::load(&study.scene)?;
-    let geom = build_wedge(&study.wedge)?;
+/// A number in its shortest form with at most 4 significant digits (20 → "20", 24.5 → "24.5").
+fn fmt_sig_short(x: f64) -> String {
+    let r = format!("{}", (x * 1e4).round() / 1e4);
+    r
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map_or_else(|| "–".to_string(), m)
+}
+
+/// The wedge study's part of the report (`report.md`, the `report` of `report.json`, the
+/// charts in `<out>/charts/`).
+pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Error> {
+    let prm = &kind.params;
+    let study = results.study;
+    let out = results.plan.out.clone();
+    let base = &results.base;
+    let geom = build_wedge(&prm.wedge)?;
     let e = geom.e;
     let line_length = (geom.p[0].powi(2) + geom.p[1].powi(2) + geom.p[2].powi(2)).sqrt();
     let mut runs = Vec::new();
-    let mut missing = Vec::new();
-    for spec in &plan.runs {
-        match read_run(&out, spec, study, e, line_length) {
-            Ok(r) => runs.push(r),
-            Err(err) => missing.push(format!("{}: {err}", spec.id)),
+    let mut unreadable = Vec::new();
+    // failed runs whose histories cannot be read (stopped before the first step): listed
+    // with the stopped runs
+    let mut stopped_early = Vec::new();
+    for res in results.runs.iter().filter(|r| r.has_results()) {
+        match (read_run(kind, res, base, e, line_length), res.failed()) {
+            (Ok(r), _) => runs.push(r),
+            (Err(_), Some(f)) => stopped_early.push((res.spec.id.clone(), f.to_string())),
+            (Err(err), None) => unreadable.push((res.spec.id.clone(), err.to_string())),
         }
     }
-    if !missing.is_empty() {
-        return Err(ModelError::Invalid(format!(
-            "the study has {} run(s) without results; run `make wedge` (or the targets of {}):\n  {}",
-            missing.len(),
-            out.join("runs.mk").display(),
-            missing.join("\n  ")
-        ))
-        .into());
-    }
-    let ssr: Option<StudySsr> = std::fs::read_to_string(out.join("ssr.json")).ok().and_then(|t| serde_json::from_str(&t).ok());
-    let le_wedge = study.wedge_of(&base);
+    let ssr: Option<StudySsr> = match results.step::<StudySsr>("ssr") {
+        Ok(s) => s,
+        Err(e) => {
+            unreadable.push(("step ssr".into(), e.to_string()));
+            None
+        }
+    };
+    let pga_list = kind.pgas(study);
+    let pgas: Vec<f64> = pga_list.iter().map(|p| p.0).collect();
+    let le_wedge = kind.wedge_of(base);
     let le_res = analyse_wedge(&le_wedge)?;
     let le_crest = analyse_wedge(&WedgeInput { height_def: HeightDef::CrestOnA, ..le_wedge.clone() })?;
     let mut rigid = Vec::new();
-    for &pga in &study.pga {
-        rigid.push(rigid_at(&base, study, pga)?);
+    for &(pga, label) in &pga_list {
+        rigid.push(rigid_at(kind, results, pga, Some(label))?);
     }
-    if !study.pga.contains(&study.accuracy_pga) {
-        rigid.push(rigid_at(&base, study, study.accuracy_pga)?);
+    if !pgas.contains(&prm.accuracy_pga) {
+        rigid.push(rigid_at(kind, results, prm.accuracy_pga, None)?);
     }
     let le = LeTable {
         fs_intersection: le_res.fs,
@@ -412,18 +423,17 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     };
     let charts_dir = out.join("charts");
     let mut charts = Vec::new();
-    let sweep = study.sweep_mesh().to_string();
-    let reference = study.reference_mesh().to_string();
+    let sweep = prm.sweep_mesh.clone();
+    let reference = prm.reference.mesh.clone();
     let rigid_of = |pga: f64| rigid.iter().find(|r| r.pga == pga).expect("rigid level of every PGA");
-    let rr = study.main_rigid_rock();
+    let rr = kind.main_rigid_rock();
     let (main_rock, other_rock) = if rr { ("rigid rock", "elastic rock") } else { ("elastic rock", "rigid rock") };
-    let is_ref = |s: &RunSpec| s.mesh == reference && s.method == "nts" && s.layer == study.reference.layer && s.e_factor == 1.0 && s.rigid_rock == rr;
-    let plain = |s: &RunSpec| s.e_factor == 1.0 && s.rigid_rock == rr;
+    let is_ref = |s: &WedgeRunSpec| s.mesh == reference && s.method == "nts" && s.layer == prm.reference.layer && s.e_factor == 1.0 && s.rigid_rock == rr;
+    let plain = |s: &WedgeRunSpec| s.e_factor == 1.0 && s.rigid_rock == rr;
 
     // ---- chart: slip against PGA (finished runs only; a failed run is listed in the tables)
     let pts = |method: &str, mesh: &str, layer: u8, rigid_rock: bool| -> Vec<(f64, f64)> {
-        study
-            .pga
+        pgas
             .iter()
             .filter_map(|&p| {
                 find(&runs, |s| s.e_factor == 1.0 && s.rigid_rock == rigid_rock && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer)
@@ -436,15 +446,15 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let ntn_sweep = pts("ntn", &sweep, 1, rr);
     let nts_other = pts("nts", &sweep, 1, !rr);
     let ntn_other = pts("ntn", &sweep, 1, !rr);
-    let reference_pts = pts("nts", &reference, study.reference.layer, rr);
+    let reference_pts = pts("nts", &reference, prm.reference.layer, rr);
     let mut c = Chart::new(format!("Residual slip at P2 against PGA ({})", base.name()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
     c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {main_rock}"), nts_sweep.clone()));
     c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, {main_rock}"), ntn_sweep.clone()));
     if reference != sweep {
-        c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh, {main_rock} (reference)", study.reference.layer), reference_pts.clone()));
+        c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh, {main_rock} (reference)", prm.reference.layer), reference_pts.clone()));
     }
-    let rigid_lost: Vec<(f64, f64)> = study.pga.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement)).collect();
-    let rigid_kept: Vec<(f64, f64)> = study.pga.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement)).collect();
+    let rigid_lost: Vec<(f64, f64)> = pgas.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement)).collect();
+    let rigid_kept: Vec<(f64, f64)> = pgas.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement)).collect();
     c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", rigid_lost.clone()));
     c.series.push(Series::line_markers("rigid block, cohesion kept", rigid_kept.clone()));
     charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga"))?.png);
@@ -459,12 +469,12 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     }
 
     // ---- chart: slip history at the accuracy PGA
-    let acc = study.accuracy_pga;
+    let acc = prm.accuracy_pga;
     let nts_acc = find(&runs, |s| plain(s) && s.pga == acc && s.method == "nts" && s.mesh == sweep && s.layer == 1);
     let ntn_acc = find(&runs, |s| plain(s) && s.pga == acc && s.method == "ntn" && s.mesh == sweep);
     let ref_acc = find(&runs, |s| is_ref(s) && s.pga == acc);
     let mut c = Chart::new(format!("Slip history at P2, PGA {acc} g"), "t [s]", "slip along the line of intersection [m]");
-    for (r, name) in [(nts_acc, format!("NTS-L1, {sweep}")), (ntn_acc, format!("NTN, {sweep}")), (ref_acc, format!("reference NTS-L{}, {reference}", study.reference.layer))] {
+    for (r, name) in [(nts_acc, format!("NTS-L1, {sweep}")), (ntn_acc, format!("NTN, {sweep}")), (ref_acc, format!("reference NTS-L{}, {reference}", prm.reference.layer))] {
         if let Some(r) = r {
             c.series.push(Series::line(name, r.slip_history.clone()));
         }
@@ -491,11 +501,12 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let mut sa: Vec<(String, f64, f64, f64)> = Vec::new(); // (level, wall, slip, error)
     sa.push(("rigid block".into(), ra.wall_time.max(1e-4), ra.brittle.result.residual_displacement, (ra.brittle.result.residual_displacement - ref_slip).abs() / ref_slip.abs()));
     for r in runs.iter().filter(|r| plain(&r.spec) && r.spec.pga == acc && !is_ref(&r.spec) && r.failed.is_none()) {
-        sa.push((r.level.clone(), r.wall_time, r.residual_slip, (r.residual_slip - ref_slip).abs() / ref_slip.abs()));
+        let Some(wall) = r.wall_time else { continue };
+        sa.push((r.level.clone(), wall, r.residual_slip, (r.residual_slip - ref_slip).abs() / ref_slip.abs()));
     }
     let pts_sa: Vec<(f64, f64)> = sa.iter().map(|x| (x.1, x.3.max(1e-4))).collect();
     let front = pareto_front(&pts_sa);
-    let mut c = Chart::new(format!("Speed against accuracy, PGA {acc} g (reference: NTS-L{} {reference})", study.reference.layer), "wall time, one thread [s]", "|slip − reference| / reference [-]");
+    let mut c = Chart::new(format!("Speed against accuracy, PGA {acc} g (reference: NTS-L{} {reference})", prm.reference.layer), "wall time, one thread [s]", "|slip − reference| / reference [-]");
     c.x_axis = Axis::Log;
     c.y_axis = Axis::Log;
     c.series.push(Series::markers("model levels", pts_sa.clone()).with_labels(sa.iter().map(|x| x.0.clone())));
@@ -514,7 +525,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
 
     // ---- cheapest level per PGA
     let mut cheapest = Vec::new();
-    for &p in &study.pga {
+    for &p in &pgas {
         let Some(r) = find(&runs, |s| is_ref(s) && s.pga == p) else { continue };
         if r.failed.is_some() {
             cheapest.push((p, "none: the reference run failed".to_string(), f64::NAN, f64::NAN));
@@ -524,11 +535,15 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         let rg = rigid_of(p);
         let mut cands: Vec<(String, f64, f64)> = vec![("rigid block".into(), rg.wall_time, rg.brittle.result.residual_displacement)];
         for x in runs.iter().filter(|x| plain(&x.spec) && x.spec.pga == p && !is_ref(&x.spec) && x.failed.is_none()) {
-            cands.push((x.level.clone(), x.wall_time, x.residual_slip));
+            if let Some(wall) = x.wall_time {
+                cands.push((x.level.clone(), wall, x.residual_slip));
+            }
         }
-        cands.push((r.level.clone() + " (reference)", r.wall_time, refv));
+        if let Some(wall) = r.wall_time {
+            cands.push((r.level.clone() + " (reference)", wall, refv));
+        }
         cands.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let tol = study.enough * refv.abs().max(0.01);
+        let tol = prm.enough * refv.abs().max(0.01);
         if let Some(c) = cands.iter().find(|c| (c.2 - refv).abs() <= tol) {
             cheapest.push((p, c.0.clone(), c.1, c.2));
         }
@@ -537,8 +552,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     // ---- trend against the seed, for each rock model
     let mut trend = Vec::new();
     for (label, nts, ntn) in [(main_rock, &nts_sweep, &ntn_sweep), (other_rock, &nts_other, &ntn_other)] {
-        let pairs: Vec<(f64, f64, f64)> = study
-            .pga
+        let pairs: Vec<(f64, f64, f64)> = pgas
             .iter()
             .filter_map(|&p| {
                 let a = nts.iter().find(|x| x.0 == p)?.1;
@@ -574,10 +588,29 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     // ---- report.md
     let mut md = String::new();
     let _ = writeln!(md, "# Wedge study: the Hoek & Bray wedge (seed paper, section 4)\n");
-    let _ = writeln!(md, "Generated by `jointquake study report` from `{}`. Units SI; slip and displacements in m.\n", plan.study.display());
+    let _ = writeln!(md, "Generated by `jointquake study report` from `{}`. Units SI; slip and displacements in m.\n", results.plan.study.display());
     let _ = writeln!(md, "## Model\n");
     let mat = base.materials.iter().map(|mm| format!("`{}` E = {} GPa, ν = {}, ρ = {} kg/m³", mm.group, mm.e / 1e9, mm.nu, mm.rho)).collect::<Vec<_>>().join("; ");
-    let _ = writeln!(md, "- Geometry `geo/wedge.geo` (planes A 45/105, B 70/235, face 65/185, upper slope 12/195; H = {} m as the vertical rise of the line of intersection); mesh levels: {}.", study.wedge.height, study.meshes.iter().map(|l| format!("{} ({})", l.name, l.set.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))).collect::<Vec<_>>().join("; "));
+    let w = &prm.wedge;
+    let plane = |p: &crate::rigid::wedge::PlaneOrientation| format!("{}/{}", p.dip, p.dip_direction);
+    let levels = study
+        .axis(&prm.mesh_axis)
+        .map(|a| a.values.iter().map(|l| format!("{} ({})", l.label, l.variation.set.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))).collect::<Vec<_>>().join("; "))
+        .unwrap_or_default();
+    let _ = writeln!(
+        md,
+        "- Geometry `{}` (planes A {}, B {}, face {}, upper slope {}; H = {} m as the {}); mesh levels: {levels}.",
+        base.geometry.geo.as_ref().or(base.geometry.msh.as_ref()).and_then(|g| g.file_name()).map(|f| format!("geo/{}", f.to_string_lossy())).unwrap_or_default(),
+        plane(&w.plane_a),
+        plane(&w.plane_b),
+        plane(&w.face),
+        plane(&w.upper),
+        w.height,
+        match w.height_def {
+            HeightDef::Intersection => "vertical rise of the line of intersection",
+            HeightDef::CrestOnA => "height of the crest point on plane A above the toe",
+        }
+    );
     let _ = writeln!(md, "- Materials: {mat}. The seed gives no elastic constants; these are chosen (a moderately jointed rock mass) and the sensitivity to E is below.");
     let dc = base.joints.iter().filter_map(|j| j.softening_slip).fold(0.0, f64::max);
     let loss = if dc > 0.0 {
@@ -585,7 +618,21 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     } else {
         "Cohesion is lost at a pair's first slip or opening (brittle)".to_string()
     };
-    let _ = writeln!(md, "- Joints: A φ = 20°, c = 24 kPa; B φ = 30°, c = 48 kPa (seed table 1). {loss}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).");
+    let strength = base
+        .joints
+        .iter()
+        .filter(|j| [&prm.joints.a, &prm.joints.b].contains(&&j.name))
+        .map(|j| {
+            let phi = match (j.mu, j.phi) {
+                (Some(mu), _) => mu.atan().to_degrees(),
+                (None, Some(p)) => p,
+                (None, None) => 0.6f64.atan().to_degrees(),
+            };
+            format!("{} φ = {}°, c = {} kPa", j.name, fmt_sig_short(phi), fmt_sig_short(j.cohesion.unwrap_or(0.0) / 1e3))
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    let _ = writeln!(md, "- Joints: {strength} (seed table 1). {loss}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).");
     let grav = base.loads.gravity.as_ref().and_then(|g| g.groups.clone()).map(|g| g.join(", ")).unwrap_or_else(|| "all".into());
     let _ = writeln!(md, "- Gravity on: {grav} (the rock is a weightless support, as in limit equilibrium); brought to equilibrium before the record.");
     let _ = writeln!(
@@ -595,7 +642,7 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     );
     let recs = base.loads.base.iter().map(|b| format!("`{}` along ({}, {}, {}) × {}", b.record.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(), b.direction[0], b.direction[1], b.direction[2], b.pga.map(|p| format!("PGA {p} g")).or(b.scale.map(|s| format!("scale {s}"))).unwrap_or_else(|| "1".into()))).collect::<Vec<_>>().join("; ");
     let _ = writeln!(md, "- Base motion (base scene): {recs}. Every record is scaled by one factor so that the horizontal PGA takes the study values: by default the committed El Centro 1940 NS record horizontally (y, north) and 2/3 of the same record vertically (z), in phase. The seed used the Koyna record, which is not public.");
-    let _ = writeln!(md, "- Damping: {}. Duration {} s per run (record plus free vibration).\n", damping_text(&base), base.time.duration);
+    let _ = writeln!(md, "- Damping: {}. Duration {} s per run (record plus free vibration).\n", damping_text(base), base.time.duration);
 
     let _ = writeln!(md, "## Static factor of safety\n");
     let mut t = Table::new(["method", "geometry (what H = 39.624 m measures)", "FS"]);
@@ -628,8 +675,9 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     );
 
     let _ = writeln!(md, "## Seismic runs\n");
-    let mut t = Table::new(["PGA [g]", "level", "P1 ux", "P1 uy", "P1 uz", "slip at P2", "still sliding", "failure mode", "max opening A / B"]);
-    for &p in &study.pga {
+    let joint_names = base.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(" / ");
+    let mut t = Table::new(["PGA [g]".to_string(), "level".into(), "P1 ux".into(), "P1 uy".into(), "P1 uz".into(), "slip at P2".into(), "still sliding".into(), "failure mode".into(), format!("max opening {joint_names}")]);
+    for &p in &pgas {
         for r in runs.iter().filter(|r| r.spec.e_factor == 1.0 && r.spec.pga == p && r.spec.mesh == sweep && r.spec.layer == 1) {
             let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
             let level = format!("{}, {}", r.level, if r.spec.rigid_rock { "rigid rock" } else { "elastic rock" });
@@ -644,11 +692,14 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         let _ = t.push_row([m(p), "rigid block, cohesion kept".into(), "".into(), "".into(), "".into(), m(rg.kept.result.residual_displacement), (if rg.kept.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.kept.result.n_episodes), "".into()]);
     }
     md.push_str(&t.to_markdown());
-    let stopped: Vec<&RunResult> = runs.iter().filter(|r| r.failed.is_some()).collect();
-    if !stopped.is_empty() {
+    let stopped: Vec<&WedgeRun> = runs.iter().filter(|r| r.failed.is_some()).collect();
+    if !stopped.is_empty() || !stopped_early.is_empty() {
         let _ = writeln!(md, "\nRuns stopped by their checks (the slip they had reached is a lower bound):\n");
         for r in stopped {
             let _ = writeln!(md, "- `{}`: {}", r.spec.id, r.failed.as_deref().unwrap_or("").trim_start_matches("error: "));
+        }
+        for (id, f) in &stopped_early {
+            let _ = writeln!(md, "- `{id}` (before its first history row): {f}");
         }
     }
     let _ = writeln!(md, "\n![slip against PGA](charts/slip_vs_pga.svg)\n");
@@ -663,9 +714,9 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
     let _ = writeln!(md);
 
     let _ = writeln!(md, "## The rock's response under the wedge\n");
-    let _ = writeln!(md, "Peak absolute acceleration of the rock node `{}` below the line of intersection (NTS-L1 runs on the elastic rock, {sweep} mesh) against the PGA, and the rigid block driven by that computed motion instead of the base record (cohesion lost at the first slide): the part of the elastic-rock slip that the rock's own response explains. The rock box of `geo/wedge.geo` has fixed sides and bottom and no absorbing boundary, so its response is that of a closed box (resonant), not of a slope in a half-space.\n", study.monitors.rock);
+    let _ = writeln!(md, "Peak absolute acceleration of the rock node `{}` below the line of intersection (NTS-L1 runs on the elastic rock, {sweep} mesh) against the PGA, and the rigid block driven by that computed motion instead of the base record (cohesion lost at the first slide): the part of the elastic-rock slip that the rock's own response explains. The rock box of `geo/wedge.geo` has fixed sides and bottom and no absorbing boundary, so its response is that of a closed box (resonant), not of a slope in a half-space.\n", prm.monitors.rock);
     let mut t = Table::new(["PGA [g]", "rock peak x / y / z [g]", "amplification y / PGA", "rigid block on the base record", "rigid block on the rock's motion", "FEM NTS-L1"]);
-    for &p in &study.pga {
+    for &p in &pgas {
         if let Some(r) = find(&runs, |s| s.e_factor == 1.0 && !s.rigid_rock && s.pga == p && s.method == "nts" && s.mesh == sweep && s.layer == 1) {
             let pk = r.rock_peak_accel.map(|a| format!("{} / {} / {}", m(a[0]), m(a[1]), m(a[2]))).unwrap_or_else(|| "–".into());
             let amp = r.rock_peak_accel.map(|a| m(a[1] / p)).unwrap_or_else(|| "–".into());
@@ -692,11 +743,11 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         let _ = t.push_row([x.0.clone(), m(x.1), m(x.2), fmt_percent(x.3, 1), (if front.contains(&i) { "yes" } else { "" }).into()]);
     }
     if let Some(r) = ref_acc {
-        let _ = t.push_row([format!("{} (reference)", r.level), m(r.wall_time), m(r.residual_slip), "0".into(), "".into()]);
+        let _ = t.push_row([format!("{} (reference)", r.level), opt(r.wall_time), m(r.residual_slip), "0".into(), "".into()]);
     }
     md.push_str(&t.to_markdown());
     let _ = writeln!(md, "\n![speed against accuracy](charts/speed_accuracy.svg)\n");
-    let _ = writeln!(md, "Cheapest level whose residual slip is within {} of the reference (or of 1 cm when the reference is smaller), for each PGA:\n", fmt_percent(study.enough, 0));
+    let _ = writeln!(md, "Cheapest level whose residual slip is within {} of the reference (or of 1 cm when the reference is smaller), for each PGA:\n", fmt_percent(prm.enough, 0));
     let mut t = Table::new(["PGA [g]", "cheapest sufficient level", "wall time [s]", "slip [m]"]);
     for (p, l, w, s) in &cheapest {
         let num = |x: f64| if x.is_finite() { m(x) } else { "–".to_string() };
@@ -707,19 +758,17 @@ pub fn write_report(study: &WedgeStudy) -> Result<WedgeReport, Error> {
         let _ = writeln!(md, "\n![strength reduction](charts/ssr.svg)\n");
     }
     let _ = writeln!(md, "\n## Runs\n");
-    let mut t = Table::new(["run", "nodes", "elements", "dt [s]", "steps", "wall time [s]", "slip [m]", "lost node-steps A / B"]);
+    let mut t = Table::new(["run".to_string(), "nodes".into(), "elements".into(), "dt [s]".into(), "steps".into(), "wall time [s]".into(), "slip [m]".into(), format!("lost node-steps {joint_names}")]);
     for r in &runs {
-        let lost = r.lost_node_steps.iter().map(|(_, v)| v.to_string()).collect::<Vec<_>>().join(" / ");
+        let lost = r.lost_node_steps.iter().map(|(_, v)| v.map_or_else(|| "–".to_string(), |v| v.to_string())).collect::<Vec<_>>().join(" / ");
         let slip = if r.failed.is_some() { format!("failed (≥ {})", m(r.max_slip)) } else { m(r.residual_slip) };
-        let _ = t.push_row([r.spec.id.clone(), r.nodes.to_string(), r.elements.to_string(), fmt_sig(r.dt, 3), r.steps.to_string(), m(r.wall_time), slip, lost]);
+        let count = |x: Option<usize>| x.map_or_else(|| "–".to_string(), |x| x.to_string());
+        let _ = t.push_row([r.spec.id.clone(), count(r.nodes), count(r.elements), r.dt.map_or_else(|| "–".to_string(), |x| fmt_sig(x, 3)), count(r.steps), opt(r.wall_time), slip, lost]);
     }
     md.push_str(&t.to_markdown());
-    let report = out.join("report.md");
-    crate::report::file::write_atomic(&report, md.as_bytes())?;
-    let rep = WedgeReport { le, ssr, runs, rigid, cheapest, trend, charts, report: report.clone() };
-    let json = out.join("report.json");
-    crate::report::file::write_atomic(&json, serde_json::to_string_pretty(&rep).expect("report serialises").as_bytes())?;
-    Ok(rep)
+    let lines = trend.clone();
+    let rep = WedgeReport { le, ssr, runs, rigid, cheapest, trend };
+    Ok(KindReport { markdown: md, json: serde_json::to_value(&rep).expect("the report serialises"), charts, lines, unreadable, lists_failed: true })
 }
 
 fn damping_text(s: &Scene) -> String {
@@ -735,12 +784,12 @@ fn damping_text(s: &Scene) -> String {
 
 /// Charts of one wedge run (e.g. the demo): slip at P2 against time next to the rigid block
 /// under the same scene's records, and the displacement of P1, in `<run_dir>/charts/`.
-/// Returns the PNG paths and the run's residual slip [m].
-pub fn write_run_charts(study: &WedgeStudy, scene_path: &Path, run_dir: &Path) -> Result<(Vec<PathBuf>, f64), Error> {
+pub fn run_charts(kind: &WedgeKind, scene_path: &Path, run_dir: &Path) -> Result<RunCharts, Error> {
+    let prm = &kind.params;
     let scene = Scene::load(scene_path)?;
-    let geom = build_wedge(&study.wedge)?;
-    let hist = |name: &str| read_point_history(&run_dir.join("histories").join(format!("{name}.csv")));
-    let (w, r, p1) = (hist(&study.monitors.p2_wedge)?, hist(&study.monitors.p2_rock)?, hist(&study.monitors.p1)?);
+    let geom = build_wedge(&prm.wedge)?;
+    let hist = |name: &str| PointHistory::read(&run_dir.join("histories").join(format!("{name}.csv")));
+    let (w, r, p1) = (hist(&prm.monitors.p2_wedge)?, hist(&prm.monitors.p2_rock)?, hist(&prm.monitors.p1)?);
     let slip = slip_series(&w, &r, geom.e);
     let (motions, _) = base_motions(&scene)?;
     let dt = motions.iter().map(|b| b.record.dt).fold(f64::INFINITY, f64::min);
@@ -751,7 +800,7 @@ pub fn write_run_charts(study: &WedgeStudy, scene_path: &Path, run_dir: &Path) -
     if dt.is_finite() {
         let a = sample_ground_motion(&motions, dt, scene.time.duration);
         for (bond, name) in [(Bond::Brittle, "rigid block, cohesion lost at first slide"), (Bond::Kept, "rigid block, cohesion kept")] {
-            let rg = rigid_wedge_slip(&study.wedge_of(&scene), &a, dt, bond, true)?;
+            let rg = rigid_wedge_slip(&kind.wedge_of(&scene), &a, dt, bond, true)?;
             if let Some(h) = rg.result.history {
                 c.series.push(Series::line(name, sampled_history(&h, dt)));
             }
@@ -764,5 +813,6 @@ pub fn write_run_charts(study: &WedgeStudy, scene_path: &Path, run_dir: &Path) -
         c.series.push(Series::line(*axis, thin(&p1.t.iter().zip(&p1.u).map(|(&t, u)| (t, u[k] - u0[k])).collect::<Vec<_>>(), 2000)));
     }
     charts.push(c.write_png_svg(&dir.join("p1_history"))?.png);
-    Ok((charts, slip.last().map(|s| s.1).unwrap_or(0.0)))
+    let residual = slip.last().map(|s| s.1).expect("a history has rows");
+    Ok(RunCharts { charts, lines: vec![format!("residual slip at P2: {residual:.4} m")] })
 }

@@ -1,0 +1,241 @@
+//! Reading a study's results back, typed, run by run, and writing the report scaffold.
+//!
+//! Each planned run is one of: finished (its `summary.json` read as a
+//! [`RunSummary`](crate::pipeline::RunSummary)), failed (the run stopped with an error:
+//! `failed.txt`; its histories end there), or without results (never run, stale because its
+//! scene changed after it ran, or a result file that does not parse). Nothing is filled in:
+//! a study reads histories by column name ([`HistoryTable`]) and reports what it cannot read,
+//! by run, instead of a zero or a NaN.
+
+use super::file::Study;
+use super::plan::{load_base, Plan, PlannedRun, PlannedStep, RunSpec};
+use super::{KindReport, StudyKind};
+use crate::error::{Error, OutputError};
+use crate::output::history::HistoryTable;
+use crate::pipeline::RunSummary;
+use crate::report::Table;
+use crate::scene::Scene;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// What became of a run.
+#[derive(Clone, Debug, Serialize)]
+#[serde(rename_all = "snake_case", tag = "status", content = "message")]
+pub enum RunStatus {
+    Finished,
+    /// Stopped with this error (its histories end there).
+    Failed(String),
+    /// No usable result: why.
+    Missing(String),
+}
+
+/// One run's results.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    pub spec: RunSpec,
+    pub dir: PathBuf,
+    /// The run's scene (as planned).
+    pub scene: Option<Scene>,
+    /// Its summary (finished runs only).
+    pub summary: Option<RunSummary>,
+    pub status: RunStatus,
+}
+
+impl RunResult {
+    pub fn id(&self) -> &str {
+        &self.spec.id
+    }
+
+    /// The history of monitor `name` (`histories/<name>.csv`).
+    pub fn history(&self, name: &str) -> Result<HistoryTable, OutputError> {
+        HistoryTable::read(&self.dir.join("histories").join(format!("{name}.csv")))
+    }
+
+    /// The history of joint `name` (`histories/joint_<name>.csv`).
+    pub fn joint_history(&self, name: &str) -> Result<HistoryTable, OutputError> {
+        HistoryTable::read(&self.dir.join("histories").join(format!("joint_{name}.csv")))
+    }
+
+    /// Whether the run has results to read (finished, or failed with partial histories).
+    pub fn has_results(&self) -> bool {
+        !matches!(self.status, RunStatus::Missing(_))
+    }
+
+    pub fn failed(&self) -> Option<&str> {
+        match &self.status {
+            RunStatus::Failed(e) => Some(e),
+            _ => None,
+        }
+    }
+
+    fn read(p: &PlannedRun) -> RunResult {
+        let mtime = |f: &Path| std::fs::metadata(f).and_then(|m| m.modified()).ok();
+        let scene = Scene::load(&p.scene);
+        let done = p.dir.join(".done");
+        let failed = p.dir.join("failed.txt");
+        let summary = p.dir.join("summary.json");
+        let (scene, mut status) = match scene {
+            Ok(s) => (Some(s), RunStatus::Finished),
+            Err(e) => (None, RunStatus::Missing(format!("its scene cannot be read: {e} (re-run `jointquake study plan`)"))),
+        };
+        let mut sum = None;
+        if matches!(status, RunStatus::Finished) {
+            status = match (mtime(&done), mtime(&p.scene)) {
+                (None, _) if !summary.exists() && !failed.exists() => RunStatus::Missing(format!("not run (no results in {})", p.dir.display())),
+                (Some(d), Some(s)) if d < s => RunStatus::Missing("stale: its scene changed after it ran".into()),
+                _ => match std::fs::read_to_string(&failed) {
+                    Ok(t) => RunStatus::Failed(t.trim().trim_start_matches("error: ").to_string()),
+                    Err(_) => match RunSummary::read(&summary) {
+                        Ok(s) => {
+                            sum = Some(s);
+                            RunStatus::Finished
+                        }
+                        Err(e) => RunStatus::Missing(e.to_string()),
+                    },
+                },
+            };
+        }
+        RunResult { spec: p.spec.clone(), dir: p.dir.clone(), scene, summary: sum, status }
+    }
+}
+
+/// A study step's result file, if it is there.
+#[derive(Clone, Debug)]
+pub struct StepResult {
+    pub step: PlannedStep,
+    /// The file's text, or why there is none (failed, not run).
+    pub text: Result<String, String>,
+}
+
+/// Everything a study's report reads.
+pub struct StudyResults<'a> {
+    pub study: &'a Study,
+    pub plan: Plan,
+    /// The base scene (absolute paths).
+    pub base: Scene,
+    pub runs: Vec<RunResult>,
+    pub steps: Vec<StepResult>,
+}
+
+impl<'a> StudyResults<'a> {
+    /// Read the plan of `study` and every run and step it names.
+    pub fn read(study: &'a Study) -> Result<StudyResults<'a>, Error> {
+        let plan = Plan::read(&study.out)?;
+        let base = load_base(study)?;
+        let runs = plan.runs.iter().map(RunResult::read).collect();
+        let steps = plan
+            .steps
+            .iter()
+            .map(|s| {
+                let failed = PathBuf::from(format!("{}.failed.txt", s.output.display()));
+                let text = match std::fs::read_to_string(&s.output) {
+                    Ok(t) => Ok(t),
+                    Err(_) => Err(match std::fs::read_to_string(&failed) {
+                        Ok(f) => format!("failed: {}", f.trim().trim_start_matches("error: ")),
+                        Err(_) => format!("not run (no {}; see {})", s.output.display(), s.log.display()),
+                    }),
+                };
+                StepResult { step: s.clone(), text }
+            })
+            .collect();
+        Ok(StudyResults { study, plan, base, runs, steps })
+    }
+
+    pub fn run(&self, id: &str) -> Option<&RunResult> {
+        self.runs.iter().find(|r| r.spec.id == id)
+    }
+
+    /// The result of step `name`, typed: `Ok(None)` when it has no result (the reason is in
+    /// the report's status section), an error when the file is there but does not parse.
+    pub fn step<T: serde::de::DeserializeOwned>(&self, name: &str) -> Result<Option<T>, OutputError> {
+        match self.steps.iter().find(|s| s.step.name == name) {
+            Some(StepResult { text: Ok(t), step }) => serde_json::from_str(t).map(Some).map_err(|e| OutputError::read(&step.output, format!("not a `{name}` result: {e}"))),
+            _ => Ok(None),
+        }
+    }
+}
+
+/// Files and messages of a written report.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReportFiles {
+    pub report: PathBuf,
+    pub json: PathBuf,
+    pub charts: Vec<PathBuf>,
+    /// One-line findings of the study for the terminal.
+    pub lines: Vec<String>,
+    /// Runs and steps without results, or whose results the study could not read: (id, why).
+    pub problems: Vec<(String, String)>,
+}
+
+#[derive(Serialize)]
+struct RunStatusJson<'a> {
+    id: &'a str,
+    labels: &'a [(String, String)],
+    #[serde(flatten)]
+    status: &'a RunStatus,
+}
+
+/// Read the results of `study`, let its kind write its part, and write `<out>/report.md` (the
+/// kind's Markdown, then the runs and steps without results) and `<out>/report.json`.
+pub fn write_report(study: &Study, kind: &dyn StudyKind) -> Result<ReportFiles, Error> {
+    let results = StudyResults::read(study)?;
+    let KindReport { mut markdown, json, charts, lines, unreadable, lists_failed } = kind.report(&results)?;
+    let mut problems: Vec<(String, String)> = Vec::new();
+    for r in &results.runs {
+        match &r.status {
+            RunStatus::Missing(m) => problems.push((r.spec.id.clone(), m.clone())),
+            RunStatus::Failed(m) if !lists_failed => problems.push((r.spec.id.clone(), format!("failed: {m}"))),
+            _ => {}
+        }
+    }
+    for s in &results.steps {
+        if let Err(m) = &s.text {
+            problems.push((format!("step {}", s.step.name), m.clone()));
+        }
+    }
+    problems.extend(unreadable);
+    if !problems.is_empty() {
+        let _ = writeln!(markdown, "\n## Runs without results\n");
+        let _ = writeln!(markdown, "These are left out of the tables and charts above; `make -f {} all` runs what is missing.\n", results.plan.out.join("runs.mk").display());
+        for (id, why) in &problems {
+            let _ = writeln!(markdown, "- `{id}`: {why}");
+        }
+    }
+    let out = &results.plan.out;
+    let report = out.join("report.md");
+    crate::report::file::write_atomic(&report, markdown.as_bytes())?;
+    let status: Vec<RunStatusJson> = results.runs.iter().map(|r| RunStatusJson { id: &r.spec.id, labels: &r.spec.labels, status: &r.status }).collect();
+    let doc = serde_json::json!({
+        "study": results.plan.study,
+        "kind": results.plan.kind,
+        "runs": status,
+        "problems": problems,
+        "report": json,
+    });
+    let jpath = out.join("report.json");
+    crate::report::file::write_atomic(&jpath, serde_json::to_string_pretty(&doc).expect("the report serialises").as_bytes())?;
+    Ok(ReportFiles { report, json: jpath, charts, lines, problems })
+}
+
+/// The table every study can show: each run's status, size, step, wall time and joint maxima.
+pub fn run_table(results: &StudyResults) -> Table {
+    let mut t = Table::new(["run", "status", "nodes", "elements", "dt [s]", "steps", "wall time [s]", "joint maxima: opening / slip [m]"]);
+    let f = |x: f64| crate::report::fmt_sig(x, 4);
+    for r in &results.runs {
+        let status = match &r.status {
+            RunStatus::Finished => "finished".to_string(),
+            RunStatus::Failed(e) => format!("failed: {e}"),
+            RunStatus::Missing(e) => format!("no results: {e}"),
+        };
+        let row = match &r.summary {
+            Some(s) => {
+                let joints = s.joints.iter().map(|j| format!("{} {} / {}", j.name, f(j.max_opening), f(j.max_slip))).collect::<Vec<_>>().join("; ");
+                [r.spec.id.clone(), status, s.nodes.to_string(), s.elements.to_string(), crate::report::fmt_sig(s.dt, 3), s.steps.to_string(), f(s.wall_time), joints]
+            }
+            None => [r.spec.id.clone(), status, "–".into(), "–".into(), "–".into(), "–".into(), "–".into(), "–".into()],
+        };
+        let _ = t.push_row(row);
+    }
+    t
+}
