@@ -35,6 +35,7 @@ pub mod pipeline;
 pub mod report;
 pub mod rigid;
 pub mod scene;
+pub mod scene_patterns;
 pub mod study;
 
 pub use error::{Error, Result};

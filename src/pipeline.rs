@@ -91,6 +91,14 @@ pub fn load_mesh(scene: &Scene, opts: &RunOptions) -> Result<Mesh, Error> {
     Ok(Mesh::from_msh(path)?)
 }
 
+/// Expand the scene's group patterns against the mesh (`scene_patterns`); errors become scene
+/// errors naming the scene file.
+pub fn expand_patterns(scene: &mut Scene, mesh: &Mesh, scene_path: &Path) -> Result<Vec<crate::scene_patterns::PatternUse>, Error> {
+    scene
+        .expand_group_patterns(&crate::scene_patterns::mesh_group_names(mesh))
+        .map_err(|e| crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message: e.to_string() }.into())
+}
+
 /// Snap monitored points to nodes (optionally of a group).
 pub fn snap_monitors(model: &Model, scene: &Scene) -> Result<Vec<Monitor>, Error> {
     let mut out = Vec::new();
@@ -132,6 +140,7 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         scene.time.duration = d;
     }
     let mesh = load_mesh(&scene, opts)?;
+    expand_patterns(&mut scene, &mesh, scene_path)?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");
     let model = Model::build(mesh, &scene)?;
@@ -536,7 +545,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
     use crate::error::InterfaceError;
     use crate::interface::{tag_joint, write_joint_json, write_joint_vtu, JointSpec};
     let t_all = Instant::now();
-    let scene = Scene::load(scene_path)?;
+    let mut scene = Scene::load(scene_path)?;
     if scene.joints.is_empty() {
         return Err(crate::error::SceneError::Invalid {
             path: scene_path.to_path_buf(),
@@ -544,6 +553,8 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
         }
         .into());
     }
+    let mesh = load_mesh(&scene, opts)?;
+    expand_patterns(&mut scene, &mesh, scene_path)?;
     let mut stems: Vec<(String, &str)> = Vec::new();
     for j in &scene.joints {
         if j.name.is_empty() {
@@ -559,7 +570,6 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
         }
         stems.push((stem, &j.name));
     }
-    let mesh = load_mesh(&scene, opts)?;
     let model_size = mesh_diagonal(&mesh);
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
     let dir = out_dir.join("tagging");
