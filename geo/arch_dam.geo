@@ -369,7 +369,7 @@ For m In {1:NM}
     // abutment wedge: unstructured tet4 at the through-thickness size
     MeshSize{ PointsOf{ Volume{v}; } } = ht;
   Else
-    hz = Max(H - Uz[kl], H - Uz[kr]);
+    hz = H - Min(Min(Uz[kl], Uz[kr]), Min(Dz[kl], Dz[kr]));   // the tallest of its 4 profiles
     nz = Ceil(hz / h);
     If (nz < 2)
       nz = 2;

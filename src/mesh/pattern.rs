@@ -47,9 +47,54 @@ fn available_text(available: &[String]) -> String {
     if available.is_empty() {
         return "The mesh has no such group.".into();
     }
-    let shown: Vec<&str> = available.iter().take(12).map(|s| s.as_str()).collect();
-    let more = if available.len() > shown.len() { format!(" and {} more", available.len() - shown.len()) } else { String::new() };
+    let fams = summarize_names(available);
+    let shown: Vec<&str> = fams.iter().take(16).map(|s| s.as_str()).collect();
+    let more = if fams.len() > shown.len() { format!(" and {} more", fams.len() - shown.len()) } else { String::new() };
     format!("Groups that exist: {}{more}.", shown.join(", "))
+}
+
+/// Names with numbered families collapsed: `block:monolith:01` … `block:monolith:29` becomes
+/// `block:monolith:01…29 (29 groups)`; a family is the names equal once every digit run is
+/// replaced by `#`, shown when it has 3 or more members. Order: first appearance.
+pub fn summarize_names(names: &[String]) -> Vec<String> {
+    let key = |n: &str| {
+        let mut k = String::new();
+        let mut in_digits = false;
+        for c in n.chars() {
+            if c.is_ascii_digit() {
+                if !in_digits {
+                    k.push('#');
+                }
+                in_digits = true;
+            } else {
+                k.push(c);
+                in_digits = false;
+            }
+        }
+        k
+    };
+    let mut fams: Vec<(String, Vec<&str>)> = Vec::new();
+    for n in names {
+        let k = key(n);
+        match fams.iter_mut().find(|(fk, _)| *fk == k) {
+            Some((_, v)) => v.push(n),
+            None => fams.push((k, vec![n])),
+        }
+    }
+    let mut out = Vec::new();
+    for (_, mut v) in fams {
+        if v.len() < 3 {
+            out.extend(v.iter().map(|s| s.to_string()));
+            continue;
+        }
+        v.sort_by(|a, b| natural_cmp(a, b));
+        let (first, last) = (v[0], v[v.len() - 1]);
+        // the common prefix up to the first differing digit run
+        let p = first.char_indices().zip(last.chars()).take_while(|((_, a), b)| a == b).count();
+        let p = first[..p].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
+        out.push(format!("{first}…{} ({} groups)", &last[p..], v.len()));
+    }
+    out
 }
 
 #[derive(Clone, Debug, PartialEq)]
