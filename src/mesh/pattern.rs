@@ -53,8 +53,8 @@ fn available_text(available: &[String]) -> String {
     format!("Groups that exist: {}{more}.", shown.join(", "))
 }
 
-/// Names with numbered families collapsed: `block:monolith:01` … `block:monolith:29` becomes
-/// `block:monolith:01…29 (29 groups)`; a family is the names equal once every digit run is
+/// Names with numbered families collapsed: `block:monolith:01`, …, `block:monolith:29` becomes
+/// `block:monolith:01 … block:monolith:29 (29 groups)`; a family is the names equal once every digit run is
 /// replaced by `#`, shown when it has 3 or more members. Order: first appearance.
 pub fn summarize_names(names: &[String]) -> Vec<String> {
     let key = |n: &str| {
@@ -88,11 +88,7 @@ pub fn summarize_names(names: &[String]) -> Vec<String> {
             continue;
         }
         v.sort_by(|a, b| natural_cmp(a, b));
-        let (first, last) = (v[0], v[v.len() - 1]);
-        // the common prefix up to the first differing digit run
-        let p = first.char_indices().zip(last.chars()).take_while(|((_, a), b)| a == b).count();
-        let p = first[..p].rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
-        out.push(format!("{first}…{} ({} groups)", &last[p..], v.len()));
+        out.push(format!("{} … {} ({} groups)", v[0], v[v.len() - 1], v.len()));
     }
     out
 }
@@ -380,6 +376,12 @@ mod tests {
         let e = p.match_name("ja-b-c").unwrap_err();
         assert!(matches!(e, PatternError::Ambiguous { .. }), "{e}");
         assert_eq!(p.match_name("ja-b").unwrap().unwrap()["B"], "b");
+    }
+
+    #[test]
+    fn numbered_families_are_summarized() {
+        let names: Vec<String> = (1..=12).map(|k| format!("joint:{k:02}:left")).chain(["bc:far".to_string(), "j1".into(), "j2".into()]).collect();
+        assert_eq!(summarize_names(&names), ["joint:01:left … joint:12:left (12 groups)", "bc:far", "j1", "j2"]);
     }
 
     #[test]
