@@ -299,11 +299,144 @@ Macro CrestArc       // from joint ak to joint ak+1 on face af at z = H, points 
   cv = newc; Spline(cv) = {ap[]};
 Return
 
+
+// Abutment wedge (monolith 1 or N+1) between the crest end `we`, joint `wk` and the bank, as
+// three transfinite blocks: its triangular section (crest end A, joint crest B, joint foot C)
+// split into 3 quads by the edge midpoints and the centroid G, each swept from the upstream to
+// the downstream face. wflip = 1 for the right wedge (mirror order, so the cells stay
+// positively oriented). Out: wvol[] (3 volumes), wU[], wD[], wC[], wB[], wJ[] (its faces).
+Macro ArcBetween     // spline on crest face af (0 up, 1 down) from point a0 at x aX0 to a1 at aX1
+  ap[] = {a0};
+  For ai In {1:3}
+    axx = aX0 + (aX1 - aX0) * ai / 4;
+    If (af == 0)
+      ayy = axx*axx/(2*Rc);
+    Else
+      ayy = Yd1 + axx*axx/(2*Rd1);
+    EndIf
+    pt = newp; Point(pt) = {axx, ayy, H}; ap[] += pt;
+  EndFor
+  ap[] += a1;
+  cv = newc; Spline(cv) = {ap[]};
+Return
+Macro ProfBetween    // spline on joint pk's face pf from point p0 (z pz0) to p1 (z pz1)
+  pp[] = {p0};
+  For pi In {1:4}
+    fr_k = pk; fr_f = pf; fr_z = pz0 + (pz1 - pz0) * pi / 5;
+    Call FaceR;
+    pt = newp; Point(pt) = {jx[pk] + fr_r*jdx[pk], jy[pk] + fr_r*jdy[pk], fr_z}; pp[] += pt;
+  EndFor
+  pp[] += p1;
+  cv = newc; Spline(cv) = {pp[]};
+Return
+Macro AbutmentWedge
+  For wf In {0:1}      // 0 upstream, 1 downstream face
+    If (wf == 0)
+      wAx = CUx[we]; wAy = CUy[we]; wBx = CUx[wk]; wBy = CUy[wk]; wCx = Ux[wk]; wCy = Uy[wk]; wCz = Uz[wk];
+    Else
+      wAx = CDx[we]; wAy = CDy[we]; wBx = CDx[wk]; wBy = CDy[wk]; wCx = Dx[wk]; wCy = Dy[wk]; wCz = Dz[wk];
+    EndIf
+    pA[wf] = newp; Point(pA[wf]) = {wAx, wAy, H};
+    pB[wf] = newp; Point(pB[wf]) = {wBx, wBy, H};
+    pC[wf] = newp; Point(pC[wf]) = {wCx, wCy, wCz};
+    // midpoint of AB on the crest arc, of BC on the joint's profile, of CA on the chord
+    mx = 0.5 * (wAx + wBx);
+    If (wf == 0)
+      my = mx*mx/(2*Rc);
+    Else
+      my = Yd1 + mx*mx/(2*Rd1);
+    EndIf
+    pmAB[wf] = newp; Point(pmAB[wf]) = {mx, my, H};
+    fr_k = wk; fr_f = wf; fr_z = 0.5 * (wCz + H); Call FaceR;
+    pmBC[wf] = newp; Point(pmBC[wf]) = {jx[wk] + fr_r*jdx[wk], jy[wk] + fr_r*jdy[wk], fr_z};
+    pmCA[wf] = newp; Point(pmCA[wf]) = {0.5*(wCx + wAx), 0.5*(wCy + wAy), 0.5*(wCz + H)};
+    // centroid, moved along y onto the face
+    gx = (wAx + wBx + wCx) / 3; gz = (2*H + wCz) / 3;
+    az_z = gz; Call ArchAt;
+    If (wf == 0)
+      gy = az_Yu + gx*gx/(2*az_Ru);
+    Else
+      gy = az_Yd + gx*gx/(2*az_Rd);
+    EndIf
+    pG[wf] = newp; Point(pG[wf]) = {gx, gy, gz};
+    af = wf; a0 = pA[wf]; aX0 = wAx; a1 = pmAB[wf]; aX1 = mx; Call ArcBetween;
+    cAm[wf] = cv;
+    af = wf; a0 = pmAB[wf]; aX0 = mx; a1 = pB[wf]; aX1 = wBx; Call ArcBetween;
+    cmB[wf] = cv;
+    pk = wk; pf = wf; p0 = pC[wf]; pz0 = wCz; p1 = pmBC[wf]; pz1 = 0.5*(wCz + H); Call ProfBetween;
+    cCm[wf] = cv;
+    pk = wk; pf = wf; p0 = pmBC[wf]; pz0 = 0.5*(wCz + H); p1 = pB[wf]; pz1 = H; Call ProfBetween;
+    cmBp[wf] = cv;    // mBC -> B
+    cCmA[wf] = newc; Line(cCmA[wf]) = {pC[wf], pmCA[wf]};
+    cmAA[wf] = newc; Line(cmAA[wf]) = {pmCA[wf], pA[wf]};
+    gAB[wf] = newc; Line(gAB[wf]) = {pmAB[wf], pG[wf]};
+    gBC[wf] = newc; Line(gBC[wf]) = {pmBC[wf], pG[wf]};
+    gCA[wf] = newc; Line(gCA[wf]) = {pmCA[wf], pG[wf]};
+    l = newcl; Curve Loop(l) = {cAm[wf], gAB[wf], -gCA[wf], cmAA[wf]}; q1[wf] = news; Surface(q1[wf]) = {l};
+    l = newcl; Curve Loop(l) = {cmB[wf], -cmBp[wf], gBC[wf], -gAB[wf]}; q2[wf] = news; Surface(q2[wf]) = {l};
+    l = newcl; Curve Loop(l) = {-gBC[wf], -cCm[wf], cCmA[wf], gCA[wf]}; q3[wf] = news; Surface(q3[wf]) = {l};
+  EndFor
+  // through the thickness
+  tA = newc; Line(tA) = {pA[0], pA[1]};   tB = newc; Line(tB) = {pB[0], pB[1]};
+  tC = newc; Line(tC) = {pC[0], pC[1]};   tG = newc; Line(tG) = {pG[0], pG[1]};
+  tmAB = newc; Line(tmAB) = {pmAB[0], pmAB[1]}; tmBC = newc; Line(tmBC) = {pmBC[0], pmBC[1]};
+  tmCA = newc; Line(tmCA) = {pmCA[0], pmCA[1]};
+  l = newcl; Curve Loop(l) = {cAm[0], tmAB, -cAm[1], -tA}; K1 = news; Surface(K1) = {l};
+  l = newcl; Curve Loop(l) = {cmB[0], tB, -cmB[1], -tmAB}; K2 = news; Surface(K2) = {l};
+  l = newcl; Curve Loop(l) = {-cmBp[0], tmBC, cmBp[1], -tB}; J1 = news; Surface(J1) = {l};
+  l = newcl; Curve Loop(l) = {-cCm[0], tC, cCm[1], -tmBC}; J2 = news; Surface(J2) = {l};
+  l = newcl; Curve Loop(l) = {cCmA[0], tmCA, -cCmA[1], -tC}; W1 = news; Plane Surface(W1) = {l};
+  l = newcl; Curve Loop(l) = {cmAA[0], tA, -cmAA[1], -tmCA}; W2 = news; Plane Surface(W2) = {l};
+  l = newcl; Curve Loop(l) = {gAB[0], tG, -gAB[1], -tmAB}; I1 = news; Surface(I1) = {l};
+  l = newcl; Curve Loop(l) = {gBC[0], tG, -gBC[1], -tmBC}; I2 = news; Surface(I2) = {l};
+  l = newcl; Curve Loop(l) = {gCA[0], tG, -gCA[1], -tmCA}; I3 = news; Surface(I3) = {l};
+  sl = newsl; Surface Loop(sl) = {q1[0], q1[1], K1, I1, I3, W2}; V1 = newv; Volume(V1) = {sl};
+  sl = newsl; Surface Loop(sl) = {q2[0], q2[1], K2, J1, I2, I1}; V2 = newv; Volume(V2) = {sl};
+  sl = newsl; Surface Loop(sl) = {q3[0], q3[1], I2, J2, W1, I3}; V3 = newv; Volume(V3) = {sl};
+  wvol[] = {V1, V2, V3}; wU[] = {q1[0], q2[0], q3[0]}; wD[] = {q1[1], q2[1], q3[1]};
+  wC[] = {K1, K2}; wB[] = {W1, W2}; wJ[] = {J1, J2};
+  // divisions: every half-edge and interior line nh, through the thickness nt
+  nh = Ceil(0.5 * Max(w, H - Min(Uz[wk], Dz[wk])) / h);
+  If (nh < 2)
+    nh = 2;
+  EndIf
+  Transfinite Curve{cAm[], cmB[], cCm[], cmBp[], cCmA[], cmAA[], gAB[], gBC[], gCA[]} = nh + 1;
+  Transfinite Curve{tA, tB, tC, tG, tmAB, tmBC, tmCA} = nt + 1;
+  wS[] = {wU[], wD[], wC[], wB[], wJ[], I1, I2, I3};
+  Transfinite Surface{wS[]};
+  If (hex == 1)
+    Recombine Surface{wS[]};
+  EndIf
+  If (wflip == 0)
+    Transfinite Volume{V1} = {pA[0], pmAB[0], pG[0], pmCA[0], pA[1], pmAB[1], pG[1], pmCA[1]};
+    Transfinite Volume{V2} = {pmAB[0], pB[0], pmBC[0], pG[0], pmAB[1], pB[1], pmBC[1], pG[1]};
+    Transfinite Volume{V3} = {pG[0], pmBC[0], pC[0], pmCA[0], pG[1], pmBC[1], pC[1], pmCA[1]};
+  Else
+    Transfinite Volume{V1} = {pA[0], pmCA[0], pG[0], pmAB[0], pA[1], pmCA[1], pG[1], pmAB[1]};
+    Transfinite Volume{V2} = {pmAB[0], pG[0], pmBC[0], pB[0], pmAB[1], pG[1], pmBC[1], pB[1]};
+    Transfinite Volume{V3} = {pG[0], pmCA[0], pC[0], pmBC[0], pG[1], pmCA[1], pC[1], pmBC[1]};
+  EndIf
+Return
+
 upF[] = {}; dnF[] = {}; crF[] = {}; baseF[] = {};
 For m In {1:NM}
   kl = m - 1; kr = m;
   par = Fmod(m, 2);                 // odd monoliths: nt0 and nz; even: one more of each
   nt = nt0 + 1 - par;
+  If (m == 1 || m == NM)
+    If (m == 1)
+      wk = 1; we = 0; wflip = 0;
+    Else
+      wk = N; we = NM; wflip = 1;
+    EndIf
+    Call AbutmentWedge;
+    If (m == 1)
+      wedge1[] = wvol[]; jointLeft1[] = wJ[];
+    Else
+      wedgeN[] = wvol[]; jointRightN[] = wJ[];
+    EndIf
+    upF[] += wU[]; dnF[] += wD[]; crF[] += wC[]; baseF[] += wB[];
+  Else
   // left side: joint kl's profiles (their end points are the corners), or the crest end
   If (m > 1)
     pk = kl; pf = 0; Call ProfileCurve;
@@ -388,6 +521,7 @@ For m In {1:NM}
     EndIf
     Transfinite Volume{v} = {pUl, pUr, pDr, pDl, qCUl, qCUr, qCDr, qCDl};
   EndIf
+  EndIf
 EndFor
 
 // ------------------------------------------------------------------ rock
@@ -444,13 +578,24 @@ EndFor
 MeshSize{A1, A2, A3, A4, B1, B2, B3, B4} = hrf;
 
 // ------------------------------------------------------------------ groups
-For m In {1:NM}
+Physical Volume("block:monolith:01") = {wedge1[]};
+For m In {2:N}
   Physical Volume(Sprintf("block:monolith:%02g", m)) = {mono[m]};
 EndFor
+Physical Volume(Sprintf("block:monolith:%02g", NM)) = {wedgeN[]};
 Physical Volume("block:rock") = {rock};
+jointLeft[1] = 0; jointRight[N] = 0;
 For k In {1:N}
-  Physical Surface(Sprintf("joint:%02g:left", k)) = {jointLeft[k]};
-  Physical Surface(Sprintf("joint:%02g:right", k)) = {jointRight[k]};
+  If (k == 1)
+    Physical Surface(Sprintf("joint:%02g:left", k)) = {jointLeft1[]};
+  Else
+    Physical Surface(Sprintf("joint:%02g:left", k)) = {jointLeft[k]};
+  EndIf
+  If (k == N)
+    Physical Surface(Sprintf("joint:%02g:right", k)) = {jointRightN[]};
+  Else
+    Physical Surface(Sprintf("joint:%02g:right", k)) = {jointRight[k]};
+  EndIf
 EndFor
 Physical Surface("face:upstream") = {upF[]};
 Physical Surface("face:downstream") = {dnF[]};
@@ -462,8 +607,7 @@ Physical Surface("bc:far") = {farF[]};
 Mesh.MeshSizeExtendFromBoundary = 1;
 Mesh.MeshSizeFromCurvature = 0;
 Mesh.MeshSizeFromPoints = 1;
-// HXT (10) and re-optimising every tet of quality below 0.6: the unstructured abutment wedges
-// set the explicit time step by their smallest altitude, 0.64 m with the default Delaunay and
-// optimisation threshold against 1.23 m with these (coarse variant, ht = 3.4 m).
-Mesh.Algorithm3D = 10;
-Mesh.OptimizeThreshold = 0.6;
+// Only the rock is unstructured (tet4, Gmsh's default Delaunay): its smallest tet altitude, 7.0 m
+// on the coarse variant and 4.0 m on the default one, is far from setting the explicit step
+// (the dam's hex8, 2.2 m through the wedges' thickness, do).
+Mesh.Algorithm3D = 1;
