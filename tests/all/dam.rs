@@ -304,8 +304,10 @@ fn dam_model_builds_from_the_expanded_scene() {
 }
 
 /// geo/arch_dam.geo meshed by gmsh with the fixture's parameters gives the fixture's groups
-/// and structured counts; with hex = 0 every monolith is the same grid split into tet4 (6 per
-/// cell), still oriented.
+/// and structured counts. With hex = 0 every monolith is tet4, still oriented, and its faces are
+/// faces of its tets, so the joints tag (regression: Gmsh's transfinite split of each cell into
+/// 6 tets did not follow the triangles of the curved faces, and the tagger rejected the joint
+/// faces of the abutment wedges as "not a face of any volume element").
 #[test]
 #[ignore = "runs gmsh (make test runs it): cargo test --test all -- --ignored gmsh"]
 fn arch_dam_geo_meshes_the_coarse_variant_gmsh() {
@@ -327,7 +329,7 @@ fn arch_dam_geo_meshes_the_coarse_variant_gmsh() {
     for k in 1..=N_JOINTS + 1 {
         let g = format!("block:monolith:{k:02}");
         assert_eq!(count(&t, &g, CellKind::Hex8), 0, "{g}");
-        assert_eq!(count(&t, &g, CellKind::Tet4), 6 * count(&f, &g, CellKind::Hex8), "{g}");
+        assert!(count(&t, &g, CellKind::Tet4) > 0, "{g}");
     }
     for g in &t.groups {
         assert!(!g.cells.is_empty(), "{}", g.name);
@@ -335,4 +337,11 @@ fn arch_dam_geo_meshes_the_coarse_variant_gmsh() {
             t.check_orientation(g).unwrap();
         }
     }
+    for k in 1..=N_JOINTS {
+        let spec = JointSpec { name: format!("J{k:02}"), master: format!("joint:{k:02}:left"), slave: format!("joint:{k:02}:right"), auto: true };
+        let j = tag_joint(&t, &spec, 0.5).unwrap_or_else(|e| panic!("tet variant, joint {k}: {e}"));
+        assert!(j.ntn_max_distance > 0.0);
+    }
+    let spec = JointSpec { name: "base".into(), master: "interface:rock:base".into(), slave: "interface:dam:base".into(), auto: false };
+    tag_joint(&t, &spec, 1e-6).unwrap();
 }
