@@ -31,10 +31,11 @@
 //
 // Meshing (each monolith and the rock on its own: no shared point, curve or surface, so no
 // joint and no dam-rock interface conforms): monoliths 2..N are transfinite blocks (nw along
-// the arch, nz up, nt through the thickness; hex8 with hex = 1, the same grid split into tet4
-// with hex = 0); odd and even monoliths differ by one division through the thickness and up,
-// so the two sides of every joint differ. The two abutment monoliths (1, N+1) are wedges
-// (5 faces): unstructured tet4. The rock: unstructured tet4, hr at the dam, hrf far away.
+// the arch, nz up, nt through the thickness); the abutment wedges (1, N+1) are 3 transfinite
+// blocks each (their triangular section split at the edge midpoints and the centroid). hex = 1:
+// hex8 everywhere in the dam; hex = 0: the same structured face meshes with tet4 inside (HXT).
+// Odd and even monoliths differ by one division through the thickness and up, so the two sides
+// of every joint differ. The rock: unstructured tet4, hr at the dam, hrf far away.
 //
 // Physical groups: block:monolith:01..NN, block:rock; joint:KK:left (face of monolith KK, on
 // the left of joint KK) and joint:KK:right (face of monolith KK+1); face:upstream,
