@@ -118,6 +118,7 @@ bench: build
 	cargo bench --bench explicit
 	cargo bench --bench tagger
 	cargo bench --bench contact
+	cargo bench --bench dam
 
 # The fuzz properties of tests/all/fuzz.rs with many more cases than `make test` runs
 # (FUZZ_CASES per property, default 20000; fixed seed, so a failure reproduces).

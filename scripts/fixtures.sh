@@ -54,6 +54,8 @@ mesh prism_hex.msh            prism.geo -setnumber n 50 -setnumber nt 1
 mesh cantilever_hex.msh       cantilever.geo -setnumber nx 20 -setnumber ny 1 -setnumber nz 2
 mesh column_hex.msh           column.geo -setnumber nz 10 -setnumber nw 1
 mesh wedge_coarse.msh         wedge.geo -setnumber hw 8 -setnumber hr 30
+# the arch dam's coarse variant (docs/dam.md): 29 monoliths, 28 joints, foundation block
+mesh arch_dam_coarse.msh      arch_dam.geo -setnumber h 20 -setnumber ht 3.4 -setnumber hr 40 -setnumber hrf 200
 
 # malformed.msh: boxes_hex_4x3.msh cut 5 lines into its $Elements section (no $EndElements).
 awk '{ print } /^\$Elements/ { cut = NR + 5 } cut && NR >= cut { exit }' \

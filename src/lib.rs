@@ -52,6 +52,7 @@ pub mod rigid;
 pub mod scene;
 pub mod simulation;
 pub mod studies;
+pub mod scene_patterns;
 pub mod study;
 pub mod vtk;
 

@@ -44,6 +44,18 @@ pub fn load_mesh(scene: &Scene, opts: &RunOptions) -> Result<Mesh, Error> {
     Ok(Mesh::from_msh(path)?)
 }
 
+/// Expand the scene's group patterns against the mesh ([`crate::scene_patterns`]) and check
+/// the expanded scene again (names and joint pairs); errors name the scene file. Must run right
+/// after the mesh is read, before any group lookup.
+pub fn expand_patterns(scene: &mut Scene, mesh: &Mesh, scene_path: &Path) -> Result<Vec<crate::scene_patterns::PatternUse>, Error> {
+    let invalid = |message: String| -> Error { crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message }.into() };
+    let uses = scene.expand_group_patterns(&crate::scene_patterns::mesh_group_names(mesh)).map_err(|e| invalid(e.to_string()))?;
+    if !uses.is_empty() {
+        scene.validate().map_err(invalid)?;
+    }
+    Ok(uses)
+}
+
 /// Run a scene file end to end: the recipe.
 pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let t_all = Instant::now();
@@ -56,6 +68,7 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
         scene.time.duration = d;
     }
     let mesh = load_mesh(&scene, opts)?;
+    expand_patterns(&mut scene, &mesh, scene_path)?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");
     let problem = Problem::build(scene, mesh)?;
@@ -176,10 +189,9 @@ pub struct TagSummary {
 /// diagonal), and write `<out>/tagging/joints.json`, one `<out>/tagging/<joint>.vtu` per joint and
 /// `<out>/tagging/summary.json`. `<out>` is `opts.out_dir`, else the scene's output directory.
 pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
-    use crate::error::InterfaceError;
     use crate::interface::{tag_joint, write_joint_json, write_joint_vtu, JointSpec};
     let t_all = Instant::now();
-    let scene = Scene::load(scene_path)?;
+    let mut scene = Scene::load(scene_path)?;
     if scene.joints.is_empty() {
         return Err(crate::error::SceneError::Invalid {
             path: scene_path.to_path_buf(),
@@ -187,8 +199,10 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
         }
         .into());
     }
-    // Joint names (non-empty, distinct file stems) are checked by `Scene::validate`.
+    // Joint names (non-empty, distinct file stems) are checked by `Scene::validate`, again after
+    // the patterns are expanded.
     let mesh = load_mesh(&scene, opts)?;
+    expand_patterns(&mut scene, &mesh, scene_path)?;
     let model_size = mesh.diagonal();
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
     let dir = out_dir.join("tagging");

@@ -12,6 +12,7 @@
 
 pub mod cell;
 pub mod msh;
+pub mod pattern;
 pub mod structured;
 pub mod topology;
 
