@@ -30,6 +30,7 @@ pub mod gmsh;
 pub mod interface;
 pub mod mesh;
 pub mod model;
+pub mod motion;
 pub mod output;
 pub mod pipeline;
 pub mod report;
