@@ -9,6 +9,7 @@ mod contact;
 mod contact_validation;
 mod dynamics;
 mod mesh;
+mod motion;
 mod outputs;
 mod report;
 mod rigid;
