@@ -178,6 +178,15 @@ fn polynomial(accel: &[f64], dt: f64, degree: usize) -> Result<Vec<f64>, MotionE
 }
 
 fn highpass(accel: &[f64], dt: f64, corner: f64, order: u32) -> Vec<f64> {
+    let (pad, full) = highpass_padded(accel, dt, corner, order);
+    full[pad..pad + accel.len()].to_vec()
+}
+
+/// The zero-phase high-pass of `accel` with its padding kept (Boore 2005: the acausal filter's
+/// response before t = 0 and after the end belongs to the filtered record; cutting it off leaves
+/// the drift that [`correct`]'s window-only result shows). Returns the number of samples
+/// prepended (the record's first sample is at index `pad`) and the whole filtered series.
+pub fn highpass_padded(accel: &[f64], dt: f64, corner: f64, order: u32) -> (usize, Vec<f64>) {
     let n = accel.len();
     let pad = ((1.5 * order as f64 / corner / dt) / 2.0).ceil() as usize;
     let nfft = (n + 2 * pad).next_power_of_two();
@@ -196,7 +205,7 @@ fn highpass(accel: &[f64], dt: f64, corner: f64, order: u32) -> Vec<f64> {
     }
     planner.plan_fft_inverse(nfft).process(&mut buf);
     let s = 1.0 / nfft as f64;
-    (0..n).map(|i| buf[pad + i].re * s).collect()
+    (pad, (0..(n + 2 * pad)).map(|i| buf[i].re * s).collect())
 }
 
 #[cfg(test)]

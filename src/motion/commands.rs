@@ -50,7 +50,15 @@ pub fn info(name: &str, t0: f64, dt: f64, accel_si: &[f64], g: f64, out: &Path) 
 /// `record correct`: the corrected record to `out_file`, with the drift before and after.
 pub fn correct_file(source: &Path, t0: f64, dt: f64, accel_si: &[f64], g: f64, method: &Baseline, out_file: &Path) -> Result<String, MotionError> {
     let before = drift(accel_si, dt);
-    let c = correct(accel_si, dt, method)?;
+    // the high-pass keeps its padding (the acausal filter's response before t0 is part of it)
+    let (t0, c) = match *method {
+        Baseline::HighPass { corner, order } => {
+            method.check(dt)?;
+            let (pad, full) = super::baseline::highpass_padded(accel_si, dt, corner, order);
+            (t0 - pad as f64 * dt, full)
+        }
+        _ => (t0, correct(accel_si, dt, method)?),
+    };
     let after = drift(&c, dt);
     let ag: Vec<f64> = c.iter().map(|a| a / g).collect();
     let header = vec![
