@@ -25,7 +25,7 @@ GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes
 $(VENV)/.ready:
 	@command -v python3 >/dev/null || { echo "make: python3 is needed (apt-get install python3 python3-venv)"; exit 1; }
 	@test -x $(PY) || python3 -m venv $(VENV) || { echo "make: cannot create $(VENV): apt-get install python3-venv"; exit 1; }
-	$(PY) -m pip install --quiet --disable-pip-version-check gmsh meshio numpy
+	$(PY) -m pip install --quiet --disable-pip-version-check gmsh meshio numpy pyrotd
 	@printf '#!/bin/sh\nd=$$(dirname "$$0")\nexec "$$d/python" "$$d/gmsh" "$$@"\n' > $(VENV)/bin/gmsh-run && chmod +x $(VENV)/bin/gmsh-run
 	@if ! $(PY) -c "import gmsh" 2>/dev/null; then \
 	  echo "make: the gmsh wheel needs X11/GL libraries; installing: $(GMSH_DEBS)"; \
@@ -74,6 +74,9 @@ test: venv
 	@echo "== meshio cross-check of a scene with a joint (joint series, joint history)"
 	$(BIN) run pipelines/impact.json --out target/test-impact --quiet
 	$(PY) scripts/check_vtu.py target/test-impact
+	@echo "== 5 % response spectrum of El Centro NS against pyrotd (1 % at every period)"
+	$(PY) -c "import pyrotd" 2>/dev/null || $(PY) -m pip install --quiet --disable-pip-version-check pyrotd
+	$(PY) scripts/check_spectrum.py $(BIN) pipelines/records/elcentro1940_NS_chopra.txt target/test-spectrum
 	@echo "make test: all checks passed"
 
 # ---- stages --------------------------------------------------------------------------
@@ -119,6 +122,7 @@ bench: build
 	cargo bench --bench tagger
 	cargo bench --bench contact
 	cargo bench --bench dam
+	cargo bench --bench motion
 
 # The fuzz properties of tests/all/fuzz.rs with many more cases than `make test` runs
 # (FUZZ_CASES per property, default 20000; fixed seed, so a failure reproduces).

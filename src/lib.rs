@@ -44,6 +44,7 @@ pub mod gmsh;
 pub mod interface;
 pub mod mesh;
 pub mod model;
+pub mod motion;
 pub mod output;
 pub mod pipeline;
 pub mod problem;

@@ -130,6 +130,151 @@ enum Cmd {
         #[command(subcommand)]
         action: StudyCmd,
     },
+    /// Ground motions: `info`, `correct`, `synth`, `match` (docs/motion.md).
+    Record {
+        #[command(subcommand)]
+        action: RecordCmd,
+    },
+}
+
+/// Ground-motion stages (docs/motion.md).
+#[derive(Subcommand)]
+enum RecordCmd {
+    /// PGA, PGV, PGD, Arias intensity, D5-95, predominant period, the 5 % PSA on 0.02-10 s, and
+    /// charts of a(t), v(t), d(t) and the spectrum, in <out>/<stem>_*.
+    Info {
+        /// Records: two-column (t [s], a [g]) or PEER .AT2.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        #[arg(long, default_value = "out/records")]
+        out: PathBuf,
+        /// Standard gravity [m/s²] converting g.
+        #[arg(long, default_value_t = 9.81)]
+        g: f64,
+    },
+    /// Baseline-correct a record and report the residual end velocity and displacement.
+    Correct {
+        file: PathBuf,
+        #[command(flatten)]
+        baseline: BaselineArgs,
+        /// Output file (two columns, t [s], a [g]).
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long, default_value_t = 9.81)]
+        g: f64,
+    },
+    /// Spectrum-compatible synthetic components (h1, h2, v) from random phases.
+    Synth {
+        #[command(flatten)]
+        target: TargetArgs,
+        /// Horizontal PGA [g].
+        #[arg(long)]
+        pga: f64,
+        #[arg(long, default_value_t = 20.0)]
+        duration: f64,
+        #[arg(long, default_value_t = 0.01)]
+        dt: f64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[arg(long, default_value_t = 3)]
+        components: usize,
+        /// Vertical as a fraction of the horizontal (target and PGA). Default 2/3.
+        #[arg(long)]
+        vertical_ratio: Option<f64>,
+        /// Envelope rise, strong part and decay [s], end level (default 2, 8, 10, 0.05).
+        #[arg(long)]
+        rise: Option<f64>,
+        #[arg(long)]
+        strong: Option<f64>,
+        #[arg(long)]
+        decay: Option<f64>,
+        #[arg(long)]
+        end_level: Option<f64>,
+        #[command(flatten)]
+        fit: FitArgs,
+        #[arg(long, default_value = "out/records")]
+        out: PathBuf,
+        /// File name prefix: <out>/<name>_s<seed>_<component>.txt.
+        #[arg(long, default_value = "synth")]
+        name: String,
+    },
+    /// Match a recorded motion to a target spectrum (spectral scaling, phases kept).
+    Match {
+        file: PathBuf,
+        #[command(flatten)]
+        target: TargetArgs,
+        /// PGA of the matched record [g] (and of the code spectrum).
+        #[arg(long)]
+        pga: f64,
+        #[command(flatten)]
+        fit: FitArgs,
+        #[arg(long)]
+        out: PathBuf,
+        #[arg(long, default_value_t = 9.81)]
+        g: f64,
+    },
+}
+
+#[derive(clap::Args)]
+struct BaselineArgs {
+    /// mean | polynomial | highpass
+    #[arg(long = "method", visible_alias = "baseline", default_value = "polynomial")]
+    method: String,
+    /// Polynomial degree (3..10).
+    #[arg(long, default_value_t = 5)]
+    degree: usize,
+    /// High-pass corner [Hz].
+    #[arg(long)]
+    corner: Option<f64>,
+    /// High-pass Butterworth order.
+    #[arg(long, default_value_t = 4)]
+    order: u32,
+}
+
+#[derive(clap::Args)]
+struct TargetArgs {
+    /// Code spectrum: "DL 5073-2000" or "GB 51247-2018".
+    #[arg(long)]
+    code: Option<String>,
+    /// arch | gravity | earth-rock | other.
+    #[arg(long)]
+    structure: Option<String>,
+    /// Site class (DL 5073-2000: I-IV; GB 51247-2018: I0, I1, II-IV).
+    #[arg(long)]
+    site: Option<String>,
+    #[arg(long)]
+    basic_tg: Option<f64>,
+    #[arg(long)]
+    tg: Option<f64>,
+    #[arg(long)]
+    beta_max: Option<f64>,
+    /// User table (T [s], Sa [g]) file.
+    #[arg(long)]
+    table: Option<PathBuf>,
+    /// Uniform hazard spectrum points (T [s], Sa [g]) file.
+    #[arg(long)]
+    uhs: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct FitArgs {
+    /// Relative tolerance of the spectral match.
+    #[arg(long, default_value_t = 0.10)]
+    tolerance: f64,
+    /// Check band [s] as LO,HI.
+    #[arg(long, default_value = "0.1,3.0")]
+    band: String,
+    #[arg(long, default_value_t = 100)]
+    max_iterations: usize,
+    /// Baseline correction of every iterate: mean | polynomial | highpass.
+    #[arg(long, default_value = "polynomial")]
+    baseline: String,
+    #[arg(long, default_value_t = 5)]
+    degree: usize,
+    #[arg(long)]
+    corner: Option<f64>,
+    #[arg(long, default_value_t = 4)]
+    order: u32,
 }
 
 /// Stages of a study (a study file, docs/studies.md).
@@ -293,6 +438,90 @@ fn real_main() -> Result<()> {
             }
         }
         Cmd::Study { action } => study_cmd(action)?,
+        Cmd::Record { action } => record_cmd(action)?,
+    }
+    Ok(())
+}
+
+fn baseline_of(method: &str, degree: usize, corner: Option<f64>, order: u32) -> Result<jointquake::motion::Baseline> {
+    use jointquake::motion::Baseline;
+    Ok(match method {
+        "mean" => Baseline::Mean,
+        "polynomial" => Baseline::Polynomial { degree },
+        "highpass" => Baseline::HighPass { corner: corner.context("--method highpass needs --corner F [Hz] (e.g. 0.05)")?, order },
+        other => anyhow::bail!("baseline method \"{other}\": use mean, polynomial or highpass"),
+    })
+}
+
+fn target_of(a: &TargetArgs) -> Result<jointquake::motion::TargetSpec> {
+    use jointquake::motion::TargetSpec;
+    match (&a.table, &a.uhs, &a.structure) {
+        (Some(f), None, None) => Ok(TargetSpec::Table { points: None, file: Some(f.clone()) }),
+        (None, Some(f), None) => Ok(TargetSpec::Uhs { points: None, file: Some(f.clone()) }),
+        (None, None, Some(st)) => Ok(TargetSpec::Code {
+            code: a.code.clone().unwrap_or_else(|| "DL 5073-2000".into()),
+            structure: st.clone(),
+            site_class: a.site.clone().context("the code spectrum needs --site CLASS (DL 5073-2000: I, II, III, IV)")?,
+            basic_tg: a.basic_tg,
+            tg: a.tg,
+            beta_max: a.beta_max,
+        }),
+        (None, None, None) => anyhow::bail!("give a target spectrum: --structure arch --site I [--code \"DL 5073-2000\"], or --table FILE, or --uhs FILE"),
+        _ => anyhow::bail!("give one target spectrum: the code form (--structure, --site), --table or --uhs"),
+    }
+}
+
+fn band_of(s: &str) -> Result<[f64; 2]> {
+    let (a, b) = s.split_once(',').with_context(|| format!("--band {s:?}: expected LO,HI in seconds, e.g. 0.1,3.0"))?;
+    Ok([a.trim().parse().with_context(|| format!("--band {s:?}: {a:?} is not a number"))?, b.trim().parse().with_context(|| format!("--band {s:?}: {b:?} is not a number"))?])
+}
+
+fn record_cmd(action: RecordCmd) -> Result<()> {
+    use jointquake::dynamics::record::Record;
+    use jointquake::motion::{commands, synth};
+    let stem = |p: &PathBuf| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "record".into());
+    match action {
+        RecordCmd::Info { files, out, g } => {
+            for f in &files {
+                let r = Record::read(f, g).with_context(|| format!("reading record {}", f.display()))?;
+                let text = commands::info(&stem(f), r.t0, r.dt, &r.accel, g, &out).with_context(|| format!("record info of {}", f.display()))?;
+                say_raw!("{text}");
+            }
+        }
+        RecordCmd::Correct { file, baseline, out, g } => {
+            let r = Record::read(&file, g).with_context(|| format!("reading record {}", file.display()))?;
+            let m = baseline_of(&baseline.method, baseline.degree, baseline.corner, baseline.order)?;
+            let text = commands::correct_file(&file, r.t0, r.dt, &r.accel, g, &m, &out).with_context(|| format!("correcting {}", file.display()))?;
+            say_raw!("{text}");
+        }
+        RecordCmd::Synth { target, pga, duration, dt, seed, components, vertical_ratio, rise, strong, decay, end_level, fit, out, name } => {
+            let mut req = synth::SynthRequest::new(target_of(&target)?, pga, seed);
+            req.duration = duration;
+            req.dt = dt;
+            req.components = components;
+            if let Some(v) = vertical_ratio {
+                req.vertical_ratio = v;
+            }
+            let e = &mut req.envelope;
+            e.rise = rise.unwrap_or(e.rise);
+            e.strong = strong.unwrap_or(e.strong);
+            e.decay = decay.unwrap_or(e.decay);
+            e.end_level = end_level.unwrap_or(e.end_level);
+            req.tolerance = fit.tolerance;
+            req.band = band_of(&fit.band)?;
+            req.max_iterations = fit.max_iterations;
+            req.baseline = baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)?;
+            let (text, _) = commands::synth_files(&req, &out, &name).context("synthesising the set")?;
+            say_raw!("{text}");
+        }
+        RecordCmd::Match { file, target, pga, fit, out, g } => {
+            let r = Record::read(&file, g).with_context(|| format!("reading record {}", file.display()))?;
+            let t = target_of(&target)?.resolve(pga, "spectrum").context("the target spectrum")?;
+            let opts = synth::MatchOptions { tolerance: fit.tolerance, band: band_of(&fit.band)?, max_iterations: fit.max_iterations, baseline: baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)? };
+            let ag: Vec<f64> = r.accel.iter().map(|a| a / g).collect();
+            let text = commands::match_file(&file, r.dt, &ag, &t, pga, &opts, &out).with_context(|| format!("matching {}", file.display()))?;
+            say_raw!("{text}");
+        }
     }
     Ok(())
 }

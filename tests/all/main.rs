@@ -11,6 +11,7 @@ mod contact_validation;
 mod dynamics;
 mod fuzz;
 mod mesh;
+mod motion;
 mod outputs;
 mod report;
 mod rigid;

@@ -1,0 +1,786 @@
+//! Spectrum-compatible records: synthesis from random phases, and matching a recorded motion.
+//!
+//! **Synthesis** (after Gasparini & Vanmarcke 1976, SIMQKE): a stationary signal
+//! x(t) = Σ A_k cos(2π f_k t + φ_k) is built by an inverse FFT (rustfft, scalar planner so that
+//! the bytes do not depend on the CPU's SIMD level) with phases φ_k uniform on [0, 2π) from a
+//! ChaCha8 stream (key = the seed, stream = the component index: each component has its own
+//! independent sequence, and a seed always gives the same record), multiplied by the intensity
+//! envelope ([`Envelope`]), baseline-corrected ([`super::baseline`], default polynomial degree 5
+//! with zero end velocity and displacement) and scaled so that its PGA is the requested one.
+//! The amplitudes are then corrected in the frequency domain, A_k ← A_k · Sa_target/Sa(f_k)
+//! (the ratio interpolated in log T between the iteration periods, held constant outside), and
+//! the record rebuilt with the same phases, until the 5 % PSA is within the tolerance of the
+//! target at every check period ([`MatchCheck`]). Every iterate is corrected and scaled, so the
+//! record that passes the check is the record written.
+//!
+//! **Matching a real record**: the same iteration starting from the record's own Fourier
+//! transform (its phases, and so its time structure, are kept; no envelope is applied).
+//!
+//! Acceptance (stated, not taken from a code clause): the 5 %-damped PSA at the 60 log-spaced
+//! check periods of `band` (default 0.1–3 s, the codes' drawn range above the rising branch) is
+//! within ±`tolerance` (default 10 %) of the target at all but [`OUTSIDE_SHARE`] (10 %, 6 of 60)
+//! of them, and within ±1.5 × tolerance (15 %) at every one. Frequency-domain scaling alone
+//! stalls at about ±11–15 % at a few periods (the envelope couples neighbouring frequencies);
+//! a time-domain wavelet adjustment would be the next step to tighten it.
+//! A set that does not pass after `max_iterations` is an error ([`MotionError::NotMatched`])
+//! quoting the worst period. Components of a set must have pairwise correlation coefficients
+//! |ρ| < 0.3 (random phases give about 0.05); otherwise the set is refused (try another seed).
+
+use super::baseline::{Baseline, Drift, correct, drift};
+use super::spectrum::response_spectrum;
+use super::target::{TargetSpec, TargetSpectrum, check_pga};
+use super::{G_STANDARD, MotionError};
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::{Rng, SeedableRng};
+use rustfft::FftPlannerScalar;
+use rustfft::num_complex::Complex;
+use serde::{Deserialize, Serialize};
+
+/// Intensity envelope: rise (t/t_r)² to 1 over `rise` [s], 1 over `strong` [s], then
+/// exp(−c (t − t_2)) with c = −ln(`end_level`)/`decay`, so it is `end_level` at the envelope's end
+/// t_r + strong + decay. The record must be at least that long (after it the decay continues).
+/// Default 2 + 8 + 10 = 20 s, end level 0.05 (Jennings, Housner & Tsai 1968 shape with a strong
+/// part of 8 s, D5–95 about 10 s).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Envelope {
+    pub rise: f64,
+    pub strong: f64,
+    pub decay: f64,
+    #[serde(default = "default_end_level")]
+    pub end_level: f64,
+}
+
+fn default_end_level() -> f64 {
+    0.05
+}
+
+impl Default for Envelope {
+    fn default() -> Self {
+        Envelope { rise: 2.0, strong: 8.0, decay: 10.0, end_level: 0.05 }
+    }
+}
+
+impl Envelope {
+    pub fn length(&self) -> f64 {
+        self.rise + self.strong + self.decay
+    }
+
+    pub fn value(&self, t: f64) -> f64 {
+        if t < self.rise {
+            (t / self.rise).powi(2)
+        } else if t <= self.rise + self.strong {
+            1.0
+        } else {
+            let c = -self.end_level.ln() / self.decay;
+            (-c * (t - self.rise - self.strong)).exp()
+        }
+    }
+
+    pub fn check(&self, duration: f64, field: &str) -> Result<(), MotionError> {
+        for (name, v) in [("rise", self.rise), ("strong", self.strong), ("decay", self.decay)] {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(MotionError::invalid(format!("{field}.{name}"), format!("{v} s must be positive")));
+            }
+        }
+        if !(self.end_level > 0.0 && self.end_level < 1.0) {
+            return Err(MotionError::invalid(format!("{field}.end_level"), format!("{} must be in (0, 1)", self.end_level)));
+        }
+        if duration + 1e-9 < self.length() {
+            return Err(MotionError::invalid(
+                "duration",
+                format!(
+                    "{duration} s is shorter than the intensity envelope ({} s rise + {} s strong + {} s decay = {} s): give a longer duration or a shorter envelope",
+                    self.rise, self.strong, self.decay, self.length()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn describe(&self) -> String {
+        format!(
+            "(t/{r})^2 to {r} s, 1 to {t2} s, exp decay to {e} at {l} s",
+            r = self.rise,
+            t2 = self.rise + self.strong,
+            e = self.end_level,
+            l = self.length()
+        )
+    }
+}
+
+/// Names of the components in order: two horizontal, then the vertical.
+pub const COMPONENT_NAMES: [&str; 3] = ["h1", "h2", "v"];
+
+/// A request for a synthetic set (also the `loads.base[].synthetic` of a scene).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SynthRequest {
+    pub spectrum: TargetSpec,
+    /// Horizontal PGA [g], > 0. The vertical gets `vertical_ratio` × this.
+    pub pga: f64,
+    /// Record length [s]. Default 20.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    /// Sample interval [s]. Default 0.01 (100 Hz).
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    pub seed: u64,
+    /// Number of components: 1 (h1), 2 (h1, h2) or 3 (h1, h2, v). Default 3.
+    #[serde(default = "default_components")]
+    pub components: usize,
+    /// Vertical target and PGA as a fraction of the horizontal. Default 2/3.
+    #[serde(default = "default_vertical")]
+    pub vertical_ratio: f64,
+    #[serde(default)]
+    pub envelope: Envelope,
+    /// Relative tolerance of the spectral match. Default 0.10.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Check band [s]. Default [0.1, 3.0].
+    #[serde(default = "default_band")]
+    pub band: [f64; 2],
+    /// Iteration limit. Default 40.
+    #[serde(default = "default_iterations")]
+    pub max_iterations: usize,
+    /// Baseline correction applied to each iterate. Default polynomial, degree 5.
+    #[serde(default = "default_baseline")]
+    pub baseline: Baseline,
+}
+
+fn default_duration() -> f64 {
+    20.0
+}
+fn default_dt() -> f64 {
+    0.01
+}
+fn default_components() -> usize {
+    3
+}
+fn default_vertical() -> f64 {
+    2.0 / 3.0
+}
+fn default_tolerance() -> f64 {
+    0.10
+}
+fn default_band() -> [f64; 2] {
+    [0.1, 3.0]
+}
+fn default_iterations() -> usize {
+    100
+}
+fn default_baseline() -> Baseline {
+    Baseline::Polynomial { degree: 5 }
+}
+
+/// Half-width (in check periods) of the log-ratio smoothing of each correction.
+const SMOOTH: usize = 1;
+/// Exponent of each correction (under-relaxation: 0.5 converged on every seed tried where 1
+/// oscillated at ±11–17 %).
+const RELAXATION: f64 = 0.5;
+/// Share of the check periods that may lie outside ±tolerance (none beyond 1.5 × tolerance).
+pub const OUTSIDE_SHARE: f64 = 0.10;
+
+/// Damping ratio of the spectra matched and checked.
+pub const DAMPING: f64 = 0.05;
+/// Check and iteration periods in the band.
+pub const CHECK_POINTS: usize = 60;
+/// Largest accepted |correlation coefficient| between two components of a set.
+pub const MAX_CORRELATION: f64 = 0.3;
+
+impl SynthRequest {
+    /// A request with the defaults for everything but the target, PGA and seed.
+    pub fn new(spectrum: TargetSpec, pga: f64, seed: u64) -> SynthRequest {
+        SynthRequest {
+            spectrum,
+            pga,
+            duration: default_duration(),
+            dt: default_dt(),
+            seed,
+            components: default_components(),
+            vertical_ratio: default_vertical(),
+            envelope: Envelope::default(),
+            tolerance: default_tolerance(),
+            band: default_band(),
+            max_iterations: default_iterations(),
+            baseline: default_baseline(),
+        }
+    }
+
+    /// Check every field; `field` prefixes the names in errors.
+    pub fn check(&self, field: &str) -> Result<(), MotionError> {
+        let f = |s: &str| if field.is_empty() { s.to_string() } else { format!("{field}.{s}") };
+        check_pga(self.pga, &f("pga"))?;
+        if !(self.dt > 0.0 && self.dt <= 0.05) {
+            return Err(MotionError::invalid(f("dt"), format!("{} s must be in (0, 0.05] (20 Hz sampling at least)", self.dt)));
+        }
+        if !(self.duration > 0.0 && self.duration.is_finite() && self.duration <= 600.0) {
+            return Err(MotionError::invalid(f("duration"), format!("{} s must be in (0, 600]", self.duration)));
+        }
+        self.envelope.check(self.duration, &f("envelope")).map_err(|e| match e {
+            MotionError::Invalid { field: fl, message } if fl == "duration" => MotionError::Invalid { field: f("duration"), message },
+            other => other,
+        })?;
+        if !(1..=3).contains(&self.components) {
+            return Err(MotionError::invalid(f("components"), format!("{} must be 1, 2 or 3", self.components)));
+        }
+        if !(self.vertical_ratio > 0.0 && self.vertical_ratio <= 1.5) {
+            return Err(MotionError::invalid(f("vertical_ratio"), format!("{} must be in (0, 1.5]", self.vertical_ratio)));
+        }
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Err(MotionError::invalid(f("tolerance"), format!("{} must be in (0, 1)", self.tolerance)));
+        }
+        let [lo, hi] = self.band;
+        if !(lo > 0.0 && hi > lo) {
+            return Err(MotionError::invalid(f("band"), format!("[{lo}, {hi}] s must be increasing and positive")));
+        }
+        if lo < 4.0 * self.dt {
+            return Err(MotionError::invalid(f("band"), format!("starts at {lo} s, below 4 dt = {} s: the sampling cannot carry it", 4.0 * self.dt)));
+        }
+        if hi > self.duration / 2.0 {
+            return Err(MotionError::invalid(f("band"), format!("ends at {hi} s, beyond half the duration {} s", self.duration)));
+        }
+        if self.max_iterations == 0 {
+            return Err(MotionError::invalid(f("max_iterations"), "must be at least 1"));
+        }
+        self.baseline.check(self.dt).map_err(|e| match e {
+            MotionError::Invalid { field: fl, message } => MotionError::Invalid { field: f(&fl), message },
+            other => other,
+        })
+    }
+
+    /// The `jointquake record synth` command that makes this set.
+    pub fn command(&self) -> String {
+        let mut s = String::from("jointquake record synth");
+        match &self.spectrum {
+            TargetSpec::Code { code, structure, site_class, basic_tg, tg, beta_max } => {
+                s += &format!(" --code \"{code}\" --structure {structure} --site {site_class}");
+                if let Some(b) = basic_tg {
+                    s += &format!(" --basic-tg {b}");
+                }
+                if let Some(t) = tg {
+                    s += &format!(" --tg {t}");
+                }
+                if let Some(b) = beta_max {
+                    s += &format!(" --beta-max {b}");
+                }
+            }
+            TargetSpec::Table { file: Some(p), .. } => s += &format!(" --table {}", p.display()),
+            TargetSpec::Uhs { file: Some(p), .. } => s += &format!(" --uhs {}", p.display()),
+            TargetSpec::Table { .. } | TargetSpec::Uhs { .. } => s += " --spectrum <inline points of the scene>",
+        }
+        s += &format!(" --pga {} --duration {} --dt {} --seed {} --components {}", self.pga, self.duration, self.dt, self.seed, self.components);
+        if (self.vertical_ratio - default_vertical()).abs() > 1e-12 {
+            s += &format!(" --vertical-ratio {}", self.vertical_ratio);
+        }
+        if self.envelope != Envelope::default() {
+            let e = &self.envelope;
+            s += &format!(" --rise {} --strong {} --decay {} --end-level {}", e.rise, e.strong, e.decay, e.end_level);
+        }
+        if (self.tolerance - default_tolerance()).abs() > 1e-12 {
+            s += &format!(" --tolerance {}", self.tolerance);
+        }
+        if self.band != default_band() {
+            s += &format!(" --band {},{}", self.band[0], self.band[1]);
+        }
+        if self.max_iterations != default_iterations() {
+            s += &format!(" --max-iterations {}", self.max_iterations);
+        }
+        match &self.baseline {
+            Baseline::Polynomial { degree: 5 } => {}
+            Baseline::Polynomial { degree } => s += &format!(" --baseline polynomial --degree {degree}"),
+            Baseline::Mean => s += " --baseline mean",
+            Baseline::HighPass { corner, order } => s += &format!(" --baseline highpass --corner {corner} --order {order}"),
+        }
+        s
+    }
+}
+
+/// How well a record's 5 % PSA matches its target on the check periods.
+#[derive(Clone, Debug, Serialize)]
+pub struct MatchCheck {
+    pub band: [f64; 2],
+    pub tolerance: f64,
+    pub points: usize,
+    /// Points with |Sa/Sa_target − 1| > tolerance.
+    pub outside: usize,
+    /// Largest and smallest Sa/Sa_target − 1.
+    pub max_ratio_error: f64,
+    pub min_ratio_error: f64,
+    /// Period [s] of the largest |Sa/Sa_target − 1|.
+    pub worst_period: f64,
+    pub iterations: usize,
+}
+
+impl MatchCheck {
+    /// At most [`OUTSIDE_SHARE`] of the points outside ±tolerance, none beyond 1.5 × tolerance.
+    pub fn passed(&self) -> bool {
+        self.outside as f64 <= OUTSIDE_SHARE * self.points as f64 && self.max_ratio_error <= 1.5 * self.tolerance && -self.min_ratio_error <= 1.5 * self.tolerance
+    }
+    pub fn describe(&self) -> String {
+        format!(
+            "5 % PSA / target − 1 over {}–{} s ({} periods): {:+.1} % … {:+.1} % ({} outside ±{:.0} %; accepted: ≤ {:.0} % of the periods outside, none beyond ±{:.0} %), worst at {:.3} s, {} iterations",
+            self.band[0],
+            self.band[1],
+            self.points,
+            100.0 * self.min_ratio_error,
+            100.0 * self.max_ratio_error,
+            self.outside,
+            100.0 * self.tolerance,
+            100.0 * OUTSIDE_SHARE,
+            150.0 * self.tolerance,
+            self.worst_period,
+            self.iterations
+        )
+    }
+}
+
+/// One component of a synthetic or matched set.
+#[derive(Clone, Debug)]
+pub struct SynthComponent {
+    pub name: String,
+    pub dt: f64,
+    /// Acceleration [g].
+    pub accel_g: Vec<f64>,
+    pub target: TargetSpectrum,
+    pub pga_g: f64,
+    pub check: MatchCheck,
+    /// Drift of the last iterate before and after its baseline correction (SI).
+    pub drift_uncorrected: Drift,
+    pub drift: Drift,
+    /// `#` header lines (without the `# `), stating how the record was made.
+    pub header: Vec<String>,
+}
+
+/// A synthetic set and its component correlations.
+#[derive(Clone, Debug)]
+pub struct SynthSet {
+    pub components: Vec<SynthComponent>,
+    /// (i, j, ρ_ij) for each pair.
+    pub correlations: Vec<(usize, usize, f64)>,
+}
+
+/// The frequency-domain iteration shared by synthesis and matching.
+struct Iteration<'a> {
+    dt: f64,
+    n: usize,
+    nfft: usize,
+    periods: Vec<f64>,
+    target: Vec<f64>,
+    pga: f64,
+    baseline: &'a Baseline,
+    tolerance: f64,
+    band: [f64; 2],
+    max_iterations: usize,
+}
+
+struct Iterate {
+    accel_g: Vec<f64>,
+    check: MatchCheck,
+    drift_uncorrected: Drift,
+    drift: Drift,
+}
+
+impl Iteration<'_> {
+    /// Iterate from the spectrum `base` (length nfft, Hermitian) with an optional envelope.
+    fn run(&self, base: &[Complex<f64>], envelope: Option<&[f64]>) -> Result<Iterate, MotionError> {
+        let mut planner = FftPlannerScalar::<f64>::new();
+        let inverse = planner.plan_fft_inverse(self.nfft);
+        let half = self.nfft / 2;
+        let df = 1.0 / (self.nfft as f64 * self.dt);
+        let mut mult = vec![1.0f64; half + 1];
+        let mut buf = vec![Complex::new(0.0, 0.0); self.nfft];
+        let mut best: Option<Iterate> = None;
+        let lt: Vec<f64> = self.periods.iter().map(|t| t.ln()).collect();
+        for it in 1..=self.max_iterations {
+            for k in 0..self.nfft {
+                let kk = k.min(self.nfft - k);
+                buf[k] = base[k] * mult[kk];
+            }
+            inverse.process(&mut buf);
+            let mut a: Vec<f64> = buf[..self.n].iter().map(|z| z.re).collect();
+            if let Some(e) = envelope {
+                for (x, w) in a.iter_mut().zip(e) {
+                    *x *= w;
+                }
+            }
+            if it == 1 {
+                // the first iterate sets the level: PGA as requested, folded into the multipliers
+                let pk = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                if pk == 0.0 {
+                    return Err(MotionError::invalid("record", "all samples are zero: nothing to scale to the PGA"));
+                }
+                let s0 = self.pga / pk;
+                a.iter_mut().for_each(|x| *x *= s0);
+                mult.iter_mut().for_each(|m| *m *= s0);
+            }
+            let g = G_STANDARD;
+            let a_si: Vec<f64> = a.iter().map(|x| x * g).collect();
+            let drift_uncorrected = drift(&a_si, self.dt);
+            adjust_peaks(&mut a, self.pga);
+            let mut c = correct(&a, self.dt, self.baseline)?;
+            scale_to_pga(&mut c, self.pga);
+            let c_si: Vec<f64> = c.iter().map(|x| x * g).collect();
+            let dr = drift(&c_si, self.dt);
+            let sa = response_spectrum(&c, self.dt, &self.periods, DAMPING);
+            // the ratio smoothed over 3 neighbouring periods in log and applied with the exponent
+            // RELAXATION: the envelope spreads each frequency over about 1/(strong duration),
+            // wider than the period spacing at long periods, where raw corrections of
+            // neighbouring periods fight each other and the iteration oscillates
+            let raw: Vec<f64> = sa.iter().zip(&self.target).map(|(s, t)| (t / s.max(1e-300)).ln()).collect();
+            let ratio: Vec<f64> = (0..raw.len())
+                .map(|i| {
+                    let (a, b) = (i.saturating_sub(SMOOTH), (i + SMOOTH + 1).min(raw.len()));
+                    (raw[a..b].iter().sum::<f64>() / (b - a) as f64).exp()
+                })
+                .collect();
+            let check = self.check(&sa, it);
+            let better = best.as_ref().is_none_or(|b| {
+                let e = |m: &MatchCheck| m.max_ratio_error.max(-m.min_ratio_error);
+                e(&check) < e(&b.check)
+            });
+            let passed = check.passed();
+            if better || passed {
+                best = Some(Iterate { accel_g: c, check, drift_uncorrected, drift: dr });
+            }
+            if passed {
+                break;
+            }
+            // amplitude correction at each FFT frequency: ratio interpolated in log T
+            for (kk, m) in mult.iter_mut().enumerate().skip(1) {
+                let t = 1.0 / (kk as f64 * df);
+                *m *= interp_log(&lt, &ratio, t.ln()).powf(RELAXATION);
+            }
+        }
+        let b = best.expect("at least one iteration");
+        if !b.check.passed() {
+            return Err(MotionError::NotMatched(format!(
+                "the spectral match did not reach the tolerance: {}. Raise max_iterations, widen the tolerance, narrow the band, or check that the target is consistent with the PGA (Sa at short periods ≈ PGA)",
+                b.check.describe()
+            )));
+        }
+        Ok(b)
+    }
+
+    fn check(&self, sa: &[f64], iterations: usize) -> MatchCheck {
+        let (mut outside, mut mx, mut mn, mut worst, mut wp, mut pts) = (0, f64::NEG_INFINITY, f64::INFINITY, 0.0f64, 0.0, 0);
+        for ((&t, &s), &g) in self.periods.iter().zip(sa).zip(&self.target) {
+            if t < self.band[0] * (1.0 - 1e-9) || t > self.band[1] * (1.0 + 1e-9) {
+                continue;
+            }
+            pts += 1;
+            let e = s / g - 1.0;
+            if e.abs() > self.tolerance {
+                outside += 1;
+            }
+            mx = f64::max(mx, e);
+            mn = f64::min(mn, e);
+            if e.abs() > worst {
+                worst = e.abs();
+                wp = t;
+            }
+        }
+        MatchCheck { band: self.band, tolerance: self.tolerance, points: pts, outside, max_ratio_error: mx, min_ratio_error: mn, worst_period: wp, iterations }
+    }
+}
+
+/// Peak adjustment between spectral corrections, so that the record's largest peak is the PGA
+/// without a global scaling (which would move the whole spectrum): while a sample exceeds
+/// `pga`, the excess e is taken off with the local kernel e (δ_0 − (δ_−2 + δ_+2)/2) (two
+/// samples either side), and if the largest peak is then below `pga` the deficit is added with
+/// the same kernel. The kernel has zero sum and zero first moment, so it adds no velocity or
+/// displacement drift, and its spectrum 1 − cos(4π f dt) is small at the periods of the band
+/// (0.8 % at 1 Hz for dt = 0.01 s); the next frequency-domain correction absorbs what it does.
+fn adjust_peaks(a: &mut [f64], pga: f64) {
+    const M: usize = 2;
+    let n = a.len();
+    if n < 2 * M + 1 {
+        return;
+    }
+    let argmax = |a: &[f64]| {
+        let (mut ip, mut pk) = (M, 0.0f64);
+        for (i, x) in a.iter().enumerate().take(n - M).skip(M) {
+            if x.abs() > pk {
+                pk = x.abs();
+                ip = i;
+            }
+        }
+        (ip, pk)
+    };
+    let apply = |a: &mut [f64], i: usize, e: f64| {
+        a[i] -= e;
+        a[i - M] += 0.5 * e;
+        a[i + M] += 0.5 * e;
+    };
+    // the first and last M samples are under the envelope's ends; keep them below the PGA
+    for i in (0..M).chain(n - M..n) {
+        a[i] = a[i].clamp(-pga, pga);
+    }
+    for _ in 0..(4 * n) {
+        let (ip, pk) = argmax(a);
+        if pk <= pga {
+            break;
+        }
+        apply(a, ip, (pk - pga).copysign(a[ip]));
+    }
+    let (ip, pk) = argmax(a);
+    if pk < pga && pk > 0.0 {
+        apply(a, ip, -(pga - pk).copysign(a[ip]));
+    }
+}
+
+/// Scale to the PGA [g] exactly: the peak sample is set to ±pga after the scaling.
+fn scale_to_pga(a: &mut [f64], pga: f64) {
+    let (mut ip, mut pk) = (0, 0.0f64);
+    for (i, x) in a.iter().enumerate() {
+        if x.abs() > pk {
+            pk = x.abs();
+            ip = i;
+        }
+    }
+    if pk == 0.0 {
+        return;
+    }
+    let s = pga / pk;
+    for x in a.iter_mut() {
+        *x *= s;
+    }
+    a[ip] = pga.copysign(a[ip]);
+}
+
+/// Linear interpolation of y over x (increasing), constant outside.
+fn interp_log(x: &[f64], y: &[f64], t: f64) -> f64 {
+    if t <= x[0] {
+        return y[0];
+    }
+    if t >= x[x.len() - 1] {
+        return y[y.len() - 1];
+    }
+    let i = x.partition_point(|v| *v <= t).max(1);
+    let f = (t - x[i - 1]) / (x[i] - x[i - 1]);
+    y[i - 1] + f * (y[i] - y[i - 1])
+}
+
+/// Iteration periods: the check band on [`CHECK_POINTS`] log-spaced periods, extended at the same
+/// spacing a little beyond both ends (so the correction is not held flat right at the band's edge),
+/// but not below 4 dt.
+fn iteration_periods(band: [f64; 2], dt: f64) -> Vec<f64> {
+    let step = (band[1] / band[0]).ln() / (CHECK_POINTS - 1) as f64;
+    let lo = (band[0].ln() - 6.0 * step).max((4.0 * dt).ln());
+    let hi = band[1].ln() + 6.0 * step;
+    let mut p: Vec<f64> = (0..CHECK_POINTS).map(|i| (band[0].ln() + step * i as f64).exp()).collect();
+    let mut k = 1;
+    while band[0].ln() - step * k as f64 >= lo - 1e-12 {
+        p.push((band[0].ln() - step * k as f64).exp());
+        k += 1;
+    }
+    let mut k = 1;
+    while band[1].ln() + step * k as f64 <= hi + 1e-12 {
+        p.push((band[1].ln() + step * k as f64).exp());
+        k += 1;
+    }
+    p.sort_by(f64::total_cmp);
+    p
+}
+
+/// Uniform [0, 1) from the top 53 bits of the stream's next word.
+fn unit(rng: &mut ChaCha8Rng) -> f64 {
+    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// The random-phase stream of component `c` of `seed`.
+pub fn phase_stream(seed: u64, c: u64) -> ChaCha8Rng {
+    let mut key = [0u8; 32];
+    key[..8].copy_from_slice(&seed.to_le_bytes());
+    let mut r = ChaCha8Rng::from_seed(key);
+    r.set_stream(c);
+    r
+}
+
+/// Synthesize a set of spectrum-compatible components.
+pub fn synthesize_set(req: &SynthRequest) -> Result<SynthSet, MotionError> {
+    synthesize_set_in(req, "")
+}
+
+/// [`synthesize_set`] with `field` naming the request in errors (a scene's `loads.base[i].synthetic`).
+pub fn synthesize_set_in(req: &SynthRequest, field: &str) -> Result<SynthSet, MotionError> {
+    synthesize_components(req, field, &(0..req.components).collect::<Vec<_>>())
+}
+
+/// Only the listed components (indices into [`COMPONENT_NAMES`]) of a request's set; each is the
+/// same record as in the whole set (own stream per component).
+pub fn synthesize_components(req: &SynthRequest, field: &str, which: &[usize]) -> Result<SynthSet, MotionError> {
+    req.check(field)?;
+    let fld = |s: &str| if field.is_empty() { s.to_string() } else { format!("{field}.{s}") };
+    let horizontal = req.spectrum.resolve(req.pga, &fld("spectrum"))?;
+    let n = (req.duration / req.dt).round() as usize + 1;
+    // twice the record: the frequency spacing 1/(2 duration) gives the long periods of the band
+    // enough bins to be corrected one by one
+    let nfft = (2 * n).next_power_of_two();
+    let df = 1.0 / (nfft as f64 * req.dt);
+    let periods = iteration_periods(req.band, req.dt);
+    let env: Vec<f64> = (0..n).map(|i| req.envelope.value(i as f64 * req.dt)).collect();
+    // lowest frequency carried: half the band's lowest frequency, cosine taper below it
+    let f_lo = 1.0 / (2.0 * req.band[1]);
+    let mut comps = Vec::new();
+    for &c in which {
+        if c >= req.components {
+            return Err(MotionError::invalid(fld("component"), format!("component {} is not in a set of {}", COMPONENT_NAMES.get(c).unwrap_or(&"?"), req.components)));
+        }
+        let vertical = c == 2;
+        let target = if vertical { horizontal.scaled(req.vertical_ratio) } else { horizontal.clone() };
+        let pga = if vertical { req.pga * req.vertical_ratio } else { req.pga };
+        let mut rng = phase_stream(req.seed, c as u64);
+        let mut base = vec![Complex::new(0.0, 0.0); nfft];
+        for k in 1..nfft / 2 {
+            let f = k as f64 * df;
+            let phase = std::f64::consts::TAU * unit(&mut rng);
+            let taper = if f >= f_lo { 1.0 } else if f > 0.5 * f_lo { 0.5 * (1.0 - (std::f64::consts::PI * (f - 0.5 * f_lo) / (0.5 * f_lo)).cos()) } else { 0.0 };
+            let amp = taper * target.sa(1.0 / f);
+            let z = Complex::from_polar(amp, phase);
+            base[k] = z;
+            base[nfft - k] = z.conj();
+        }
+        let it = Iteration {
+            dt: req.dt,
+            n,
+            nfft,
+            target: periods.iter().map(|&t| target.sa(t)).collect(),
+            periods: periods.clone(),
+            pga,
+            baseline: &req.baseline,
+            tolerance: req.tolerance,
+            band: req.band,
+            max_iterations: req.max_iterations,
+        };
+        let r = it.run(&base, Some(&env)).map_err(|e| match e {
+            MotionError::NotMatched(m) => MotionError::NotMatched(format!("{}component {} of seed {}: {m}", if field.is_empty() { String::new() } else { format!("{field}: ") }, COMPONENT_NAMES[c], req.seed)),
+            other => other,
+        })?;
+        let name = COMPONENT_NAMES[c].to_string();
+        let header = vec![
+            format!("jointquake record synth: spectrum-compatible synthetic acceleration, component {name} ({}) of {}", if vertical { "vertical" } else { "horizontal" }, req.components),
+            format!("command: {}", req.command()),
+            format!("target: {}{}", horizontal.label, if vertical { format!(", vertical × {:.4}", req.vertical_ratio) } else { String::new() }),
+            format!("envelope: {}; random phases: ChaCha8, key = seed {}, stream {c}", req.envelope.describe(), req.seed),
+            format!("baseline: {} (applied to every iterate)", req.baseline.describe()),
+            format!("match: {}", r.check.describe()),
+            format!("PGA {pga:.6} g; {}", r.drift.describe()),
+            format!("npts={n}  dt={} s  duration={} s", req.dt, req.dt * (n - 1) as f64),
+            "columns: time [s]   acceleration [g]".into(),
+        ];
+        comps.push(SynthComponent {
+            name,
+            dt: req.dt,
+            accel_g: r.accel_g,
+            target,
+            pga_g: pga,
+            check: r.check,
+            drift_uncorrected: r.drift_uncorrected,
+            drift: r.drift,
+            header,
+        });
+    }
+    let correlations = correlations(&comps);
+    if let Some(&(i, j, r)) = correlations.iter().find(|c| c.2.abs() >= MAX_CORRELATION) {
+        return Err(MotionError::NotMatched(format!(
+            "components {} and {} of seed {} have correlation coefficient {r:.3} (limit {MAX_CORRELATION}): use another seed",
+            comps[i].name, comps[j].name, req.seed
+        )));
+    }
+    Ok(SynthSet { components: comps, correlations })
+}
+
+/// Pearson correlation coefficient of two equally long series.
+pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len()) as f64;
+    let ma = a.iter().sum::<f64>() / n;
+    let mb = b.iter().sum::<f64>() / n;
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    sab / (saa * sbb).sqrt()
+}
+
+fn correlations(c: &[SynthComponent]) -> Vec<(usize, usize, f64)> {
+    let mut out = Vec::new();
+    for i in 0..c.len() {
+        for j in i + 1..c.len() {
+            out.push((i, j, correlation(&c[i].accel_g, &c[j].accel_g)));
+        }
+    }
+    out
+}
+
+/// Options for matching a recorded motion to a target.
+#[derive(Clone, Debug)]
+pub struct MatchOptions {
+    pub tolerance: f64,
+    pub band: [f64; 2],
+    pub max_iterations: usize,
+    pub baseline: Baseline,
+}
+
+impl Default for MatchOptions {
+    fn default() -> Self {
+        MatchOptions { tolerance: default_tolerance(), band: default_band(), max_iterations: default_iterations(), baseline: default_baseline() }
+    }
+}
+
+/// Match a recorded acceleration `accel_g` [g] at `dt` [s] to `target` (Sa in g) by spectral
+/// scaling in the frequency domain (phases kept), scaled to `pga` [g] each iterate.
+/// The record is padded with zeros to twice its length (at least) so that the correction
+/// filter's response does not wrap around; the record's own window is kept.
+pub fn match_record(accel_g: &[f64], dt: f64, target: &TargetSpectrum, pga: f64, opts: &MatchOptions, source: &str) -> Result<SynthComponent, MotionError> {
+    check_pga(pga, "pga")?;
+    if accel_g.len() < 16 {
+        return Err(MotionError::invalid("record", format!("{} samples: too short to match", accel_g.len())));
+    }
+    let dur = dt * (accel_g.len() - 1) as f64;
+    let [lo, hi] = opts.band;
+    if !(lo >= 4.0 * dt && hi > lo && hi <= dur / 2.0) {
+        return Err(MotionError::invalid("band", format!("[{lo}, {hi}] s must be increasing, start at 4 dt = {} s or later and end by half the record ({} s)", 4.0 * dt, dur / 2.0)));
+    }
+    if !(opts.tolerance > 0.0 && opts.tolerance < 1.0) {
+        return Err(MotionError::invalid("tolerance", format!("{} must be in (0, 1)", opts.tolerance)));
+    }
+    opts.baseline.check(dt)?;
+    let n = accel_g.len();
+    let nfft = (2 * n).next_power_of_two();
+    let mut base = vec![Complex::new(0.0, 0.0); nfft];
+    for (b, a) in base.iter_mut().zip(accel_g) {
+        *b = Complex::new(*a, 0.0);
+    }
+    let mut planner = FftPlannerScalar::<f64>::new();
+    planner.plan_fft_forward(nfft).process(&mut base);
+    for z in base.iter_mut() {
+        *z /= nfft as f64;
+    }
+    let periods = iteration_periods(opts.band, dt);
+    let it = Iteration {
+        dt,
+        n,
+        nfft,
+        target: periods.iter().map(|&t| target.sa(t)).collect(),
+        periods,
+        pga,
+        baseline: &opts.baseline,
+        tolerance: opts.tolerance,
+        band: opts.band,
+        max_iterations: opts.max_iterations,
+    };
+    let r = it.run(&base, None)?;
+    let header = vec![
+        format!("jointquake record match: {source} matched to a target spectrum by spectral scaling in the frequency domain (phases kept)"),
+        format!("target: {}", target.label),
+        format!("baseline: {} (applied to every iterate)", opts.baseline.describe()),
+        format!("match: {}", r.check.describe()),
+        format!("PGA {pga} g; {}", r.drift.describe()),
+        format!("npts={n}  dt={dt} s  duration={dur} s"),
+        "columns: time [s]   acceleration [g]".into(),
+    ];
+    Ok(SynthComponent { name: "matched".into(), dt, accel_g: r.accel_g, target: target.clone(), pga_g: pga, check: r.check, drift_uncorrected: r.drift_uncorrected, drift: r.drift, header })
+}
