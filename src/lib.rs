@@ -28,6 +28,7 @@ pub mod dynamics;
 pub mod error;
 pub mod gmsh;
 pub mod interface;
+pub mod linalg;
 pub mod mesh;
 pub mod model;
 pub mod output;
