@@ -34,6 +34,7 @@ pub mod model;
 pub mod output;
 pub mod pipeline;
 pub mod report;
+pub mod reservoir;
 pub mod rigid;
 pub mod scene;
 pub mod study;

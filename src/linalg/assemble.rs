@@ -284,10 +284,15 @@ pub(crate) mod tests {
     use crate::mesh::structured::{box_mesh, BoxSpec};
 
     pub(crate) fn box_model(tets: bool, div: [usize; 3]) -> Model {
-        let mesh = box_mesh(&BoxSpec::new("b", [2.0, 1.0, 1.0], div).tets(tets));
+        box_model_of([2.0, 1.0, 1.0], tets, div, 0.25)
+    }
+
+    /// A box of `size` clamped on its x0 face, E = 1 GPa, ρ = 2000 kg/m³.
+    pub(crate) fn box_model_of(size: [f64; 3], tets: bool, div: [usize; 3], nu: f64) -> Model {
+        let mesh = box_mesh(&BoxSpec::new("b", size, div).tets(tets));
         let scene: crate::scene::Scene = serde_json::from_value(serde_json::json!({
             "geometry": {"msh": "none.msh"},
-            "materials": [{"group": "block:b", "E": 1e9, "nu": 0.25, "rho": 2000.0}],
+            "materials": [{"group": "block:b", "E": 1e9, "nu": nu, "rho": 2000.0}],
             "boundary": [{"group": "b:x0"}],
             "time": {"duration": 0.0}
         }))
