@@ -26,6 +26,7 @@
 pub mod contact;
 pub mod dynamics;
 pub mod error;
+pub mod foundation;
 pub mod gmsh;
 pub mod interface;
 pub mod linalg;

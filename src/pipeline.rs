@@ -190,14 +190,37 @@ fn simulate(
     t_all: Instant,
 ) -> Result<RunSummary, Error> {
     let mut contact = if model.joints.is_empty() { None } else { Some(ContactSolver::new(&model, &model.joints)) };
+    // ---- massless blocks: condensed statically every step (after the contact correction)
+    let t_cond = Instant::now();
+    let mut condensation = crate::foundation::Condensation::build(model, faer::Par::Seq).map_err(|e| ModelError::Invalid(e.to_string()))?;
+    if let Some(c) = condensation.as_ref() {
+        let i = c.info(t_cond.elapsed().as_secs_f64());
+        notes.push(format!(
+            "massless blocks: {} unknowns condensed on {} interface unknowns (factor {} entries, {:.2} s); foundation ω² bound {:.4e} 1/s²",
+            i.condensed_unknowns, i.interface_unknowns, i.factor_entries, i.setup_time, i.omega2_bound
+        ));
+    }
 
-    // ---- time step (penalty springs add their stiffness to the highest frequency)
+    // ---- time step (penalty springs and the condensed foundation add their stiffness to the
+    // highest frequency)
     let pen_w2 = contact.as_ref().map(|c| c.penalty_omega2_bound(&model)).unwrap_or(0.0);
-    let dt_stable = if pen_w2 > 0.0 {
-        notes.push(format!("penalty springs: stable step reduced from {:.4e} s", model.stable_dt()));
-        model.stable_dt_with(pen_w2)
+    let found_w2 = condensation.as_ref().map(|c| c.omega2_bound()).unwrap_or(0.0);
+    let dt_stable = if pen_w2 + found_w2 > 0.0 {
+        if pen_w2 > 0.0 {
+            notes.push(format!("penalty springs: stable step reduced from {:.4e} s", model.stable_dt()));
+        }
+        model.stable_dt_with(pen_w2 + found_w2)
     } else {
         model.stable_dt()
+    };
+    // the step's correction: the contact force, then the condensation
+    let correction_of = |contact: &mut Option<ContactSolver>, condensation: &mut Option<crate::foundation::Condensation>, f: &mut dyn FnMut(Option<&mut dyn Correction>) -> Result<(), Error>| -> Result<(), Error> {
+        match (contact.as_mut(), condensation.as_mut()) {
+            (Some(a), Some(b)) => f(Some(&mut crate::foundation::CorrectionPair { first: a, second: b })),
+            (Some(a), None) => f(Some(a)),
+            (None, Some(b)) => f(Some(b)),
+            (None, None) => f(None),
+        }
     };
     let dt = match scene.time.dt {
         Some(dt) => {
@@ -212,19 +235,16 @@ fn simulate(
     let mut state = State::at_rest(&model);
 
     // ---- gravity equilibrium
-    let equilibrium = if loads.gravity.is_some() && scene.equilibrium.method == "relaxation" {
+    let equilibrium = if (loads.gravity.is_some() || !loads.static_forces.is_empty()) && scene.equilibrium.method == "relaxation" {
         if let Some(c) = contact.as_mut() {
             c.keep_bonds = scene.equilibrium.joint_bonds == "kept";
         }
-        let eq = relax_gravity(
-            &model,
-            &loads,
-            &mut solver,
-            &mut state,
-            contact.as_mut().map(|c| c as &mut dyn Correction),
-            scene.equilibrium.tolerance,
-            scene.equilibrium.max_steps,
-        )?;
+        let mut eq = None;
+        correction_of(&mut contact, &mut condensation, &mut |corr| {
+            eq = Some(relax_gravity(&model, &loads, &mut solver, &mut state, corr, scene.equilibrium.tolerance, scene.equilibrium.max_steps)?);
+            Ok(())
+        })?;
+        let eq = eq.expect("relaxation ran");
         if !eq.converged && eq.residual > scene.equilibrium.max_residual {
             return Err(ModelError::Invalid(format!(
                 "gravity equilibrium not reached in {} steps: residual {:.2e} > max_residual {:.1e}. Raise equilibrium.max_steps or check supports (a block without supports or contact falls freely).",
@@ -309,7 +329,10 @@ fn simulate(
         }
     }
     for k in 0..n_steps {
-        solver.step(&model, &loads, &mut state, Stage::Dynamic, contact.as_mut().map(|c| c as &mut dyn Correction))?;
+        correction_of(&mut contact, &mut condensation, &mut |corr| {
+            solver.step(&model, &loads, &mut state, Stage::Dynamic, corr)?;
+            Ok(())
+        })?;
         // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt
         let kin = Kinematics { t: state.t - dt, dt, u_prev: &solver.u_nm1, u: &state.u_prev, u_next: &state.u };
         if k % hist_stride == 0 {

@@ -85,6 +85,9 @@ pub struct Loads {
     pub gravity_nodes: Option<Vec<bool>>,
     pub base: Vec<BaseMotion>,
     pub patterns: Vec<ForcePattern>,
+    /// Forces that act with gravity (before the record, ramped in with it during relaxation,
+    /// and kept on): the reservoir's hydrostatic pressure [N] per node.
+    pub static_forces: Vec<(usize, [f64; 3])>,
 }
 
 impl Loads {
@@ -126,7 +129,26 @@ impl Loads {
             notes.push(format!("nodal force at ({:?}) snapped to node {} at distance {:.3e} m", nf.point, model.mesh.node_tags[node], dist));
             patterns.push(ForcePattern { forces: vec![(node, nf.force)], ramp: nf.ramp });
         }
-        Ok((Loads { gravity, gravity_nodes, base, patterns }, notes))
+        // nodes that carry mass but no weight (the layer of a massless block along a joint)
+        if model.weightless.iter().any(|&w| w) {
+            let mask = gravity_nodes.get_or_insert_with(|| vec![true; model.n_nodes()]);
+            for (m, &w) in mask.iter_mut().zip(&model.weightless) {
+                *m &= !w;
+            }
+        }
+        let mut static_forces = Vec::new();
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic) {
+            let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
+            let mut faces = Vec::new();
+            for g in &r.faces {
+                faces.extend(crate::reservoir::wet_faces(&model.mesh, g, &volume)?);
+            }
+            let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
+            static_forces = crate::reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
+            let total: f64 = static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
+            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N), added mass on {} nodes (Σ m_a {:.4e} kg)", spec.level, spec.depth(), static_forces.len(), total, model.added_mass.len(), model.added_mass.iter().map(|a| a.mass).sum::<f64>()));
+        }
+        Ok((Loads { gravity, gravity_nodes, base, patterns, static_forces }, notes))
     }
 
     /// Ground acceleration vector a_g(t) [m/s²].
@@ -152,6 +174,23 @@ impl Loads {
             f[3 * n] = m * (w * g[0] - ag[0]);
             f[3 * n + 1] = m * (w * g[1] - ag[1]);
             f[3 * n + 2] = m * (w * g[2] - ag[2]);
+        }
+        if with_gravity {
+            for &(n, fv) in &self.static_forces {
+                for i in 0..3 {
+                    f[3 * n + i] += fv[i];
+                }
+            }
+        }
+        if with_dynamic && ag != [0.0; 3] {
+            // the added mass takes part in the inertial base force: −m_a n (n · a_g)
+            for a in &model.added_mass {
+                let n = a.normal;
+                let na = n[0] * ag[0] + n[1] * ag[1] + n[2] * ag[2];
+                for i in 0..3 {
+                    f[3 * a.node + i] -= a.mass * n[i] * na;
+                }
+            }
         }
         if with_dynamic {
             for p in &self.patterns {

@@ -268,7 +268,7 @@ impl ExplicitSolver {
         };
         // the update, one block of nodes per task; with no correction the increments are taken
         // in the same pass (u[n+1] is final)
-        let fused = correction.is_none();
+        let fused = correction.is_none() && model.added_mass.is_empty();
         let parts: Vec<[f64; 4]> = map_blocks_mut(&mut self.u_next, |b, un| {
             let first = b * NODE_BLOCK;
             for (k, unode) in un.chunks_exact_mut(3).enumerate() {
@@ -289,12 +289,33 @@ impl ExplicitSolver {
             }
             if fused { increments(3 * first..3 * first + un.len(), un) } else { [0.0; 4] }
         });
+        // wet nodes: the 3×3 inertia m I + m_a n nᵀ of the reservoir's added mass (the scalar
+        // update above used m alone); αM damps the structural mass only
+        for a in &model.added_mass {
+            let node = a.node;
+            let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
+            let m = model.mass[node];
+            let r: [f64; 3] = std::array::from_fn(|c| {
+                let i = 3 * node + c;
+                self.f_ext[i] - self.f_int[i] - an * m * (state.u[i] - state.u_prev[i]) / dt
+            });
+            for c in 0..3 {
+                let i = 3 * node + c;
+                if model.fixed[node] & (1 << c) != 0 {
+                    continue;
+                }
+                let acc = a.inverse[c][0] * r[0] + a.inverse[c][1] * r[1] + a.inverse[c][2] * r[2];
+                self.u_next[i] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * acc;
+            }
+        }
         let mut info = StepInfo::default();
         let sums = if let Some(c) = correction {
             info.correction = c.correct(model, &mut state.contact, state.t + dt, dt, &state.u_prev, &state.u, &mut self.u_next)?;
             sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]))
-        } else {
+        } else if fused {
             add_parts(&parts)
+        } else {
+            sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]))
         };
         if dynamic {
             let e = &mut state.energy;
@@ -366,6 +387,17 @@ impl ExplicitSolver {
             }
             [ke, se_mixed, se]
         });
+        // the reservoir's added mass: ½ m_a (n · v)²
+        let ke = ke
+            + model
+                .added_mass
+                .iter()
+                .map(|a| {
+                    let v: [f64; 3] = std::array::from_fn(|c| (state.u[3 * a.node + c] - state.u_prev[3 * a.node + c]) / dt);
+                    let nv = a.normal[0] * v[0] + a.normal[1] * v[1] + a.normal[2] * v[2];
+                    0.5 * a.mass * nv * nv
+                })
+                .sum::<f64>();
         let e = &mut state.energy;
         e.kinetic = ke;
         e.strain = se;

@@ -106,9 +106,14 @@ fn hex_stiffness(s: &hex8::HexShape, lame: &crate::model::material::Lame) -> Vec
 /// has `include[mat]` (both triangles stored; dofs of nodes outside those elements have empty
 /// columns). Symmetrised: the element kernels are symmetric to round-off.
 pub fn stiffness(model: &Model, include: &[bool]) -> Csc {
+    stiffness_of(model, |_, mat| include[mat])
+}
+
+/// The global stiffness K of the elements for which `keep(mesh cell, material)` holds.
+pub fn stiffness_of(model: &Model, keep: impl Fn(usize, usize) -> bool) -> Csc {
     let n_nodes = model.n_nodes();
-    let tets: Vec<usize> = (0..model.tets.nodes.len()).filter(|&e| include[model.tets.mat[e] as usize]).collect();
-    let hexes: Vec<usize> = (0..model.hexes.nodes.len()).filter(|&e| include[model.hexes.mat[e] as usize]).collect();
+    let tets: Vec<usize> = (0..model.tets.nodes.len()).filter(|&e| keep(model.tets.cell[e] as usize, model.tets.mat[e] as usize)).collect();
+    let hexes: Vec<usize> = (0..model.hexes.nodes.len()).filter(|&e| keep(model.hexes.cell[e] as usize, model.hexes.mat[e] as usize)).collect();
     // node graph: neighbours (self included) of every node, sorted
     let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n_nodes];
     let mut link = |nd: &[u32]| {

@@ -19,7 +19,7 @@ pub mod assemble;
 pub mod cholesky;
 pub mod eigen;
 
-pub use assemble::{dof_map, mass_matrix, restrict, stiffness, Csc, NONE};
+pub use assemble::{dof_map, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
 pub use cholesky::SparseCholesky;
 pub use eigen::{lowest_modes, Modes, ModesOptions};
 

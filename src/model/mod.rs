@@ -97,6 +97,40 @@ pub struct Model {
     pub critical: CriticalElement,
     /// Joints (tagged interfaces with their laws), in scene order.
     pub joints: Vec<crate::contact::joint::ContactJoint>,
+    /// Per material: a massless block (stiffness only; `crate::foundation` condenses it).
+    pub massless: Vec<bool>,
+    /// Per node: the components condensed statically (nodes of massless blocks without mass,
+    /// components not fixed by the boundary conditions); such nodes are also in `fixed` (7), so
+    /// the explicit update leaves them to the condensation. 0 elsewhere.
+    pub condensed: Vec<u8>,
+    /// Per mesh cell: an element of a massless block (not of its layer along a joint): stiffness
+    /// only, no mass, no stable step.
+    pub massless_cells: Vec<bool>,
+    /// Per node: carries mass but no weight (its mass comes only from the layer of a massless
+    /// block's elements along a joint face: docs/dam_physics.md).
+    pub weightless: Vec<bool>,
+    /// Reservoir added mass m_a n nᵀ of the wet nodes (empty without a reservoir).
+    pub added_mass: Vec<AddedInertia>,
+}
+
+/// The inertia of a wet node: m I + m_a n nᵀ, and the inverse of that 3×3 block on the node's
+/// free components (rows and columns of fixed components are 0).
+#[derive(Clone, Copy, Debug)]
+pub struct AddedInertia {
+    pub node: usize,
+    /// Added mass m_a [kg] along `normal`.
+    pub mass: f64,
+    pub normal: [f64; 3],
+    pub inverse: [[f64; 3]; 3],
+}
+
+impl AddedInertia {
+    /// M v for this node's 3×3 block (structural mass `m`).
+    pub fn apply(&self, m: f64, v: [f64; 3]) -> [f64; 3] {
+        let n = self.normal;
+        let nv = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+        std::array::from_fn(|i| m * v[i] + self.mass * n[i] * nv)
+    }
 }
 
 /// Scatter target shared across threads. Safe use requires that no two concurrent writers touch
@@ -280,9 +314,9 @@ impl Model {
         // material of every mesh cell (u32::MAX: none)
         let mut owner = vec![u32::MAX; mesh.cells.len()];
         for (mi, ms) in scene.materials.iter().enumerate() {
-            if ms.rho == 0.0 {
+            if ms.rho == 0.0 && !ms.massless {
                 return Err(ModelError::Invalid(format!(
-                    "material \"{}\": rho = 0 (massless foundation) needs static condensation, which this version does not provide; give the foundation a density",
+                    "material \"{}\": rho = 0: declare a block without mass `\"massless\": true` (a massless foundation), else give its density",
                     ms.group
                 ))
                 .into());
@@ -313,6 +347,22 @@ impl Model {
         let mut shapes: Vec<HexShape> = Vec::new();
         let mut shape_key: HashMap<(usize, [i64; 21]), u32> = HashMap::new();
         let mut mass = vec![0.0; n];
+        // mass from the elements of massive blocks alone (a node with only layer mass is weightless)
+        let mut massive_mass = vec![0.0; n];
+        let massless: Vec<bool> = scene.materials.iter().map(|m| m.massless).collect();
+        // nodes of the joint faces: the elements of a massless block that touch one keep their
+        // mass (the thin massive layer along a joint on a massless block, docs/dam_physics.md)
+        let mut joint_node = vec![false; n];
+        if massless.iter().any(|&m| m) {
+            for js in &scene.joints {
+                for g in [&js.master, &js.slave] {
+                    for node in mesh.group_nodes(g)? {
+                        joint_node[node] = true;
+                    }
+                }
+            }
+        }
+        let mut element_massless_cell = vec![false; mesh.cells.len()];
         let inverted = |c: usize, mi: usize| -> crate::Error {
             MeshError::InvertedElement {
                 path: mesh.source.clone(),
@@ -329,13 +379,25 @@ impl Model {
             }
             let mi = mi as usize;
             let cell = &mesh.cells[c];
-            let rho = materials[mi].rho;
+            let layer = massless[mi] && cell.nodes().iter().any(|&v| joint_node[v as usize]);
+            if layer && materials[mi].rho == 0.0 {
+                return Err(ModelError::Invalid(format!(
+                    "material \"{}\" is massless with rho = 0, but element {} touches a joint face: a joint on a massless block needs the density of the block's layer along the joint (give `rho`; docs/dam_physics.md)",
+                    materials[mi].group, cell.tag
+                ))
+                .into());
+            }
+            let rho = if massless[mi] && !layer { 0.0 } else { materials[mi].rho };
+            element_massless_cell[c] = massless[mi] && !layer;
             match cell.kind {
                 CellKind::Tet4 => {
                     // geometry recomputed in assembly order below (not stored twice)
                     let g = tet4::tet_geometry(&tet_x(cell.nodes())).ok_or_else(|| inverted(c, mi))?;
                     for a in 0..4 {
                         mass[cell.node(a)] += rho * g.vol / 4.0;
+                        if !massless[mi] {
+                            massive_mass[cell.node(a)] += rho * g.vol / 4.0;
+                        }
                     }
                     tn.push(std::array::from_fn(|a| cell.nodes()[a]));
                     tm.push(mi as u16);
@@ -365,6 +427,9 @@ impl Model {
                     let s = &shapes[id as usize];
                     for a in 0..8 {
                         mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
+                        if !massless[mi] {
+                            massive_mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
+                        }
                     }
                     hn.push(std::array::from_fn(|a| cell.nodes()[a]));
                     hs.push(id);
@@ -401,10 +466,63 @@ impl Model {
 
         // ---- boundary conditions
         let mut fixed: Vec<u8> = mass.iter().map(|&m| if m > 0.0 { 0 } else { 7 }).collect();
+        // nodes of the massless elements (without mass: condensed)
+        let mut condensed = vec![0u8; n];
+        for (c, &ml) in element_massless_cell.iter().enumerate() {
+            if ml {
+                for &v in mesh.cells[c].nodes() {
+                    if mass[v as usize] == 0.0 {
+                        condensed[v as usize] = 7;
+                    }
+                }
+            }
+        }
         for b in &scene.boundary {
             let bits = b.fix.iter().fold(0u8, |acc, c| acc | match c.as_str() { "x" => 1, "y" => 2, _ => 4 });
             for node in mesh.group_nodes(&b.group)? {
                 fixed[node] |= bits;
+                condensed[node] &= !bits;
+            }
+        }
+        if mass.iter().all(|&m| m == 0.0) {
+            return Err(ModelError::Invalid("every material group is massless: nothing carries mass to integrate in time (a massless block supports a massive one)".into()).into());
+        }
+        let weightless: Vec<bool> = (0..n).map(|i| mass[i] > 0.0 && massive_mass[i] == 0.0).collect();
+        drop(massive_mass);
+        // ---- reservoir added mass (inertia m I + m_a n nᵀ on the wet nodes)
+        let mut added_mass = Vec::new();
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.added_mass) {
+            let volume: Vec<usize> = scene.materials.iter().map(|m| mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
+            let mut faces = Vec::new();
+            for g in &r.faces {
+                faces.extend(crate::reservoir::wet_faces(&mesh, g, &volume)?);
+            }
+            let spec = reservoir_spec(&mesh, r, &faces, scene);
+            for a in crate::reservoir::added_masses(&mesh, &faces, &spec) {
+                if mass[a.node] == 0.0 {
+                    return Err(ModelError::Invalid(format!(
+                        "reservoir face node {} has no structural mass (is the wet face on a massless block?): the added mass needs a massive dam face",
+                        mesh.node_tags[a.node]
+                    ))
+                    .into());
+                }
+                let nv = nalgebra::Vector3::from(a.normal);
+                let mut m3 = nalgebra::Matrix3::identity() * mass[a.node] + nv * nv.transpose() * a.mass;
+                for c in 0..3 {
+                    if fixed[a.node] & (1 << c) != 0 {
+                        m3.set_row(c, &nalgebra::RowVector3::zeros());
+                        m3.set_column(c, &nalgebra::Vector3::zeros());
+                        m3[(c, c)] = 1.0;
+                    }
+                }
+                let mut inv = m3.try_inverse().expect("m I + m_a n nᵀ is positive definite");
+                for c in 0..3 {
+                    if fixed[a.node] & (1 << c) != 0 {
+                        inv.set_row(c, &nalgebra::RowVector3::zeros());
+                        inv.set_column(c, &nalgebra::Vector3::zeros());
+                    }
+                }
+                added_mass.push(AddedInertia { node: a.node, mass: a.mass, normal: a.normal, inverse: std::array::from_fn(|i| std::array::from_fn(|j| inv[(i, j)])) });
             }
         }
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
@@ -449,9 +567,19 @@ impl Model {
             beta,
             critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
             joints,
+            massless,
+            massless_cells: element_massless_cell,
+            condensed,
+            weightless,
+            added_mass,
         };
         model.critical = model.max_element_eigenvalue();
         Ok(model)
+    }
+
+    /// Whether the model has massless blocks to condense.
+    pub fn has_massless(&self) -> bool {
+        self.massless.iter().any(|&m| m)
     }
 
     pub fn n_nodes(&self) -> usize {
@@ -471,8 +599,13 @@ impl Model {
     /// The element with the largest ω²_max (element eigenvalue theorem: the global ω_max is bounded
     /// by the largest element ω_max with lumped mass).
     fn max_element_eigenvalue(&self) -> CriticalElement {
+        // an element of a massless block sets no stable step (its nodes are condensed, or carry
+        // the mass of other elements: the foundation's bound on them is `crate::foundation`'s);
+        // its layer elements along a joint have their mass and count as usual
+        let pure_massless = |cell: u32| self.massless_cells[cell as usize];
         let t = (0..self.tets.nodes.len())
             .into_par_iter()
+            .filter(|&e| !pure_massless(self.tets.cell[e]))
             .map(|e| {
                 let m = &self.materials[self.tets.mat[e] as usize];
                 let g = &self.tets.geom[e];
@@ -494,11 +627,14 @@ impl Model {
             .zip(&shape_mat)
             .map(|(s, &mi)| {
                 let m = &self.materials[mi as usize];
-                hex8::max_eigenvalue(s, m.rho, &m.lame)
+                if m.rho > 0.0 { hex8::max_eigenvalue(s, m.rho, &m.lame) } else { 0.0 }
             })
             .collect();
         let mut best = t;
         for e in 0..self.hexes.nodes.len() {
+            if pure_massless(self.hexes.cell[e]) {
+                continue;
+            }
             let w = shape_omega[self.hexes.shape[e] as usize];
             let c = self.hexes.cell[e] as usize;
             if w > best.0 || (w == best.0 && c < best.1) {
@@ -621,4 +757,12 @@ impl Model {
         let m = if e < nt { self.tets.mat[e] } else { self.hexes.mat[e - nt] };
         &self.materials[m as usize].lame
     }
+}
+
+/// The reservoir of a scene on its wet faces: ρw, pool level, bottom (default: the lowest wet
+/// node), g (the scene's gravity, else its standard g).
+pub fn reservoir_spec(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[crate::reservoir::WetFace], scene: &Scene) -> crate::reservoir::ReservoirSpec {
+    let lowest = faces.iter().flat_map(|f| f.nodes.iter()).map(|&v| mesh.nodes[v][2]).fold(f64::INFINITY, f64::min);
+    let g = scene.loads.gravity.as_ref().map(|g| g.g).unwrap_or(scene.g);
+    crate::reservoir::ReservoirSpec { rho_w: r.rho_w, level: r.level, bottom: r.bottom.unwrap_or(lowest), g }
 }
