@@ -16,14 +16,13 @@
 //! - `JQ_BENCH_STEPS`: steps per repeat, default 400;
 //! - `JQ_BENCH_GS_TOL`: Gauss–Seidel tolerance as a fraction of the joint size, default the
 //!   solver's (1e-12).
-use jointquake::contact::force::ContactSolver;
-use jointquake::dynamics::{loads::Loads, Correction, ExplicitSolver, Stage, State};
 use jointquake::mesh::structured::{add_box, BoxSpec};
 use jointquake::mesh::Mesh;
-use jointquake::model::Model;
+use jointquake::problem::Problem;
+use jointquake::simulation::Simulation;
 use std::time::Instant;
 
-fn build(n: usize, with_joint: bool) -> (Model, jointquake::scene::Scene) {
+fn build(n: usize, with_joint: bool) -> Problem {
     let mut mesh = Mesh { source: "<bench>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
     add_box(&mut mesh, &BoxSpec::new("lower", [1.0, 1.0, 0.2], [n, n, 4]).at([0.0, 0.0, -0.2]));
     add_box(&mut mesh, &BoxSpec::new("upper", [1.0, 1.0, 0.2], [n - 1, n - 1, 4]));
@@ -39,62 +38,48 @@ fn build(n: usize, with_joint: bool) -> (Model, jointquake::scene::Scene) {
         "boundary": [{"group": "lower:z0"}],
         "joints": joints,
         "loads": {"traction": [{"group": "upper:z1", "traction": [1e4, 0.0, -1e6]}]},
-        "time": {"duration": 1.0}
+        "time": {"duration": 1.0, "energy_tolerance": 1.0}
     }))
     .unwrap();
-    (Model::build(mesh, &sc).unwrap(), sc)
+    Problem::build(sc, mesh).unwrap()
 }
 
-/// A model stepped repeatedly: solver, state, contact solver, loads.
-struct Run<'m> {
-    model: &'m Model,
-    loads: Loads,
-    solver: ExplicitSolver,
-    state: State,
-    contact: Option<ContactSolver<'m>>,
+/// A problem stepped repeatedly (the run object at the scene's default step, 0.9 of the stable
+/// step), with the Gauss–Seidel sweeps counted.
+struct Run<'p> {
+    sim: Simulation<'p>,
     sweeps: usize,
 }
 
-impl<'m> Run<'m> {
-    fn new(model: &'m Model, sc: &jointquake::scene::Scene, dt: f64, contact: bool) -> Run<'m> {
-        let (loads, _) = Loads::build(model, sc).unwrap();
-        let mut solver = ExplicitSolver::new(model, dt, 1.0);
-        let mut state = State::at_rest(model);
-        solver.start_energy(model, &mut state);
-        let contact = contact.then(|| {
-            let mut cs = ContactSolver::new(model, &model.joints);
-            if let Some(r) = std::env::var("JQ_BENCH_GS_TOL").ok().and_then(|v| v.parse::<f64>().ok()) {
-                cs.gs_tolerance = r * model.joints[0].tag.size;
-            }
-            cs
-        });
-        Run { model, loads, solver, state, contact, sweeps: 0 }
+impl<'p> Run<'p> {
+    fn new(problem: &'p Problem) -> Run<'p> {
+        let mut sim = Simulation::new(problem).unwrap();
+        if let (Some(cs), Some(r)) = (sim.contact.as_mut(), std::env::var("JQ_BENCH_GS_TOL").ok().and_then(|v| v.parse::<f64>().ok())) {
+            cs.gs_tolerance = r * problem.joints[0].tag.size;
+        }
+        Run { sim, sweeps: 0 }
     }
 
     /// Seconds for `n` steps.
     fn steps(&mut self, n: usize) -> f64 {
         let t = Instant::now();
         for _ in 0..n {
-            let info = match self.contact.as_mut() {
-                Some(cs) => self.solver.step(self.model, &self.loads, &mut self.state, Stage::Dynamic, Some(cs as &mut dyn Correction)),
-                None => self.solver.step(self.model, &self.loads, &mut self.state, Stage::Dynamic, None),
-            }
-            .unwrap();
+            let info = self.sim.step().unwrap();
             self.sweeps += info.correction.iterations;
         }
         t.elapsed().as_secs_f64()
     }
 
     fn active_pairs(&self) -> usize {
-        self.state.contact.joints.first().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).unwrap_or(0)
+        self.sim.state.contact.joints.first().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).unwrap_or(0)
     }
 
     /// FNV-1a over the bits of u and of every pair's forces, gap, slip and face.
     fn state_hash(&self) -> u64 {
         let mut h = 0xcbf29ce484222325u64;
         let mut eat = |v: u64| h = (h ^ v).wrapping_mul(0x100000001b3);
-        self.state.u.iter().for_each(|v| eat(v.to_bits()));
-        for j in &self.state.contact.joints {
+        self.sim.state.u.iter().for_each(|v| eat(v.to_bits()));
+        for j in &self.sim.state.contact.joints {
             for p in &j.pairs {
                 [p.r_n, p.r_t[0], p.r_t[1], p.gap, p.slip, p.d_t[0], p.d_t[1], p.hist.slip].iter().for_each(|v| eat(v.to_bits()));
                 eat(p.face as u64);
@@ -118,17 +103,18 @@ fn main() {
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     pool.install(|| {
-        let (free, sc_free) = build(n, false);
-        let (with, sc_with) = build(n, true);
-        let dt = 0.9 * with.stable_dt().min(free.stable_dt());
+        let free = build(n, false);
+        let with = build(n, true);
         let slaves = with.joints[0].tag.n_slave();
-        let mut a = Run::new(&free, &sc_free, dt, false);
-        let mut b = Run::new(&with, &sc_with, dt, true);
+        let mut a = Run::new(&free);
+        let mut b = Run::new(&with);
+        // one mesh, one material: the same stable step with and without the joint
+        assert_eq!(a.sim.dt(), b.sim.dt());
         a.steps(200);
         b.steps(200);
         b.sweeps = 0;
         // time the parts of the contact correction over the repeats
-        b.contact.as_mut().unwrap().timings = Some(Default::default());
+        b.sim.contact.as_mut().unwrap().timings = Some(Default::default());
         let (mut t_free, mut t_with, mut per_pair, mut ratio) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut active = Vec::new();
         for _ in 0..repeats {
@@ -142,21 +128,21 @@ fn main() {
             active.push(act);
         }
         let best = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
-        let frac = slaves as f64 / with.n_nodes() as f64;
+        let frac = slaves as f64 / with.model.n_nodes() as f64;
         let sweeps = b.sweeps as f64 / (repeats * steps) as f64;
-        println!("contact benchmark (1 thread, load average {load}): n = {n}, {} nodes, {} hex8, {} slave nodes ({:.1} % of the nodes), {} active pairs", with.n_nodes(), with.n_elements(), slaves, 100.0 * frac, active[repeats - 1]);
+        println!("contact benchmark (1 thread, load average {load}): n = {n}, {} nodes, {} hex8, {} slave nodes ({:.1} % of the nodes), {} active pairs", with.model.n_nodes(), with.model.n_elements(), slaves, 100.0 * frac, active[repeats - 1]);
         println!("  {repeats} repeats of {steps} steps; best / median");
         println!("  contact-free step   {:9.1} / {:9.1} µs", best(&t_free), median(&t_free));
         println!("  step with contact   {:9.1} / {:9.1} µs", best(&t_with), median(&t_with));
         println!("  ratio               {:9.2} / {:9.2}  (target ≤ 1.5)", best(&ratio), median(&ratio));
         println!("  per active pair     {:9.3} / {:9.3} µs per step (target ≤ 1 µs), Gauss–Seidel sweeps {sweeps:.1} per step", best(&per_pair), median(&per_pair));
-        let parts = b.contact.as_ref().unwrap().timings.clone().unwrap();
+        let parts = b.sim.contact.as_ref().unwrap().timings.clone().unwrap();
         let per_step = |d: std::time::Duration| 1e6 * d.as_secs_f64() / parts.steps.max(1) as f64;
         let (t_search, t_prepare, t_sweeps, t_record) = (per_step(parts.search), per_step(parts.prepare), per_step(parts.sweeps), per_step(parts.record));
         println!("  contact part, mean over the repeats: search and set-up {t_search:.1} µs, warm start and colouring {t_prepare:.1} µs, sweeps {t_sweeps:.1} µs, record {t_record:.1} µs per step");
         println!("  state hash after {} steps: {:016x}", 200 + repeats * steps, b.state_hash());
         let json = serde_json::json!({
-            "load_before": load, "n": n, "nodes": with.n_nodes(), "elements": with.n_elements(), "slave_nodes": slaves,
+            "load_before": load, "n": n, "nodes": with.model.n_nodes(), "elements": with.model.n_elements(), "slave_nodes": slaves,
             "slave_fraction": frac, "active_pairs": active, "steps_per_repeat": steps, "repeats": repeats,
             "step_contact_free_us": t_free, "step_with_contact_us": t_with, "overhead_ratio": ratio, "per_pair_us": per_pair,
             "best": {"step_contact_free_us": best(&t_free), "step_with_contact_us": best(&t_with), "overhead_ratio": best(&ratio), "per_pair_us": best(&per_pair)},

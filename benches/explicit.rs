@@ -1,5 +1,5 @@
 //! Explicit-dynamics benchmark (issue 2): contact-free central-difference steps
-//! (`ExplicitSolver::step`, `Stage::Dynamic`, gravity on a box fixed at its base, no damping,
+//! (`Simulation::step`: `ExplicitSolver::step`, `Stage::Dynamic`, gravity on a box fixed at its base, no damping,
 //! no contact) on structured tet4 and hex8 boxes of about 10⁴, 10⁵ and 10⁶ elements, on one and
 //! two threads, plus the Akantu/CalculiX comparison case (1 × 1 × 10 m hex8 prism of
 //! 10 × 10 × 100 elements, 1000 steps).
@@ -25,7 +25,8 @@
 //!   development VM the triad runs at memory speed from 3 × 64 MB on).
 //! - `JQ_BENCH_DUMP_U=1`: also write the displacement after the determinism check
 //!   (`target/bench/u_<case>.f64`, little-endian f64) to compare two builds.
-use jointquake::dynamics::{loads::Loads, ExplicitSolver, Stage, State};
+use jointquake::problem::Problem;
+use jointquake::simulation::Simulation;
 use jointquake::mesh::structured::{box_mesh, BoxSpec};
 use jointquake::model::Model;
 use rayon::prelude::*;
@@ -187,7 +188,7 @@ fn scene() -> jointquake::scene::Scene {
         "boundary": [{"group": "b:z0"}],
         "loads": {"gravity": {"g": 9.81}},
         "equilibrium": {"method": "none"},
-        "time": {"duration": 1.0}
+        "time": {"duration": 1.0, "energy_tolerance": 1.0}
     }))
     .unwrap()
 }
@@ -208,20 +209,17 @@ fn child(case: &Case) -> serde_json::Value {
     let reset = reset_peak_rss();
     let sc = scene();
     let t0 = Instant::now();
-    let model = Model::build(mesh, &sc).unwrap();
+    // the model, its (no) joints and loads; the run object at the scene's default step (0.9 of
+    // the stable step)
+    let problem = Problem::build(sc, mesh).unwrap();
     let t_model = t0.elapsed().as_secs_f64();
-    let (loads, _) = Loads::build(&model, &sc).unwrap();
-    let dt = 0.9 * model.stable_dt();
+    let model: &Model = &problem.model;
     let ne = model.n_elements();
-    let fresh = || {
-        let mut solver = ExplicitSolver::new(&model, dt, 1.0);
-        let mut state = State::at_rest(&model);
-        solver.start_energy(&model, &mut state);
-        (solver, state)
-    };
-    let run = |solver: &mut ExplicitSolver, state: &mut State, steps: usize| {
+    let fresh = || Simulation::new(&problem).unwrap();
+    let dt = fresh().dt();
+    let run = |sim: &mut Simulation, steps: usize| {
         for _ in 0..steps {
-            solver.step(&model, &loads, state, Stage::Dynamic, None).unwrap();
+            sim.step().unwrap();
         }
     };
     // determinism: the same steps from rest on 1 and 2 threads
@@ -230,9 +228,9 @@ fn child(case: &Case) -> serde_json::Value {
     for &k in &[1usize, 2] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(k).build().unwrap();
         let u = pool.install(|| {
-            let (mut s, mut st) = fresh();
-            run(&mut s, &mut st, CHECK_STEPS);
-            st.u
+            let mut sim = fresh();
+            run(&mut sim, CHECK_STEPS);
+            sim.state.u
         });
         hashes.push(hash_bits(&u));
         u_check = u;
@@ -250,35 +248,35 @@ fn child(case: &Case) -> serde_json::Value {
     // timing: the thread counts take turns repeat by repeat, so that both see the same load
     // from the other users of the machine
     let pools: Vec<rayon::ThreadPool> = case.threads.iter().map(|&k| rayon::ThreadPoolBuilder::new().num_threads(k).build().unwrap()).collect();
-    let mut runs: Vec<(ExplicitSolver, State, usize, Vec<f64>)> = pools
+    let mut runs: Vec<(Simulation, usize, Vec<f64>)> = pools
         .iter()
         .map(|pool| {
             pool.install(|| {
-                let (mut s, mut st) = fresh();
+                let mut sim = fresh();
                 let t = Instant::now();
-                run(&mut s, &mut st, 2);
+                run(&mut sim, 2);
                 let per_step = t.elapsed().as_secs_f64() / 2.0;
                 let steps = case.steps.unwrap_or_else(|| ((seconds / per_step).round() as usize).clamp(3, 20000));
-                (s, st, steps, Vec::new())
+                (sim, steps, Vec::new())
             })
         })
         .collect();
     for _ in 0..repeats {
-        for (pool, (s, st, steps, rates)) in pools.iter().zip(runs.iter_mut()) {
+        for (pool, (sim, steps, rates)) in pools.iter().zip(runs.iter_mut()) {
             pool.install(|| {
                 let t = Instant::now();
-                run(s, st, *steps);
+                run(sim, *steps);
                 rates.push((ne * *steps) as f64 / t.elapsed().as_secs_f64());
             });
         }
     }
     let mut per_threads = Vec::new();
-    for (&k, (_, _, steps, rates)) in case.threads.iter().zip(&runs) {
+    for (&k, (_, steps, rates)) in case.threads.iter().zip(&runs) {
         eprintln!("  {:<44} {k} thread(s): {steps:5} steps × {repeats}: best {:.3e}, median {:.3e} element-steps/s", case.label, best(rates), median(rates));
         per_threads.push(serde_json::json!({"threads": k, "steps_per_repeat": steps, "rates": rates, "best": best(rates), "median": median(rates)}));
     }
     drop(runs);
-    let tr = traffic(&model);
+    let tr = traffic(model);
     serde_json::json!({
         "label": case.label, "kind": if case.tets { "tet4" } else { "hex8" }, "divisions": case.divisions, "size_m": case.size,
         "elements": ne, "nodes": model.n_nodes(), "chunks": model.tets.schedule.chunks.len() + model.hexes.schedule.chunks.len(), "colours": model.tets.schedule.colors.len() + model.hexes.schedule.colors.len(), "hex_shapes": model.hexes.shapes.len(), "dt": dt,

@@ -134,10 +134,10 @@ impl OutputError {
     }
 }
 
-/// Building study reports: charts (PNG + SVG) and Markdown tables ([`crate::report`]).
+/// Building study reports: charts (PNG + SVG) and Markdown tables (module `report`).
 ///
 /// Chart variants name the chart by its title and the series by its name; point indices
-/// are 0-based positions in [`crate::report::Series::points`].
+/// are 0-based positions in `report::Series::points`.
 #[derive(Debug, Error)]
 pub enum ReportError {
     #[error("chart \"{chart}\": series \"{series}\", point {index} = ({x}, {y}) is not finite. Drop the point (a failed run?) or replace it before charting.")]

@@ -24,7 +24,7 @@
 //! sum Σ_j |K_ij| / √(m_i m_j) over the interface dofs ([`Condensation::omega2_bound`]), added to
 //! the element bound of the massive elements (λ_max(A + B) ≤ λ_max(A) + λ_max(B)).
 
-use crate::dynamics::{Correction, CorrectionInfo};
+use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
 use crate::linalg::{dof_map, restrict, stiffness_of, Csc, LinalgError, SparseCholesky, NONE};
 use crate::model::Model;
@@ -84,12 +84,12 @@ impl Condensation {
             if bmap[j] == NONE {
                 continue;
             }
-            let mj = model.mass[j / 3];
+            let mj = model.mass.inertial[j / 3];
             let mut s = 0.0;
             for p in k.col_ptr[j]..k.col_ptr[j + 1] {
                 let i = k.row[p];
                 if bmap[i] != NONE {
-                    s += k.val[p].abs() / (mj * model.mass[i / 3]).sqrt();
+                    s += k.val[p].abs() / (mj * model.mass.inertial[i / 3]).sqrt();
                 }
             }
             omega2 = omega2.max(s);
@@ -130,45 +130,12 @@ impl Condensation {
     }
 }
 
-impl Correction for Condensation {
+impl<H: ?Sized> Constraint<H> for Condensation {
     /// The condensed displacements of the predicted (and contact-corrected) u[n+1]; no work is
-    /// done (the condensed unknowns carry no load and the strain energy ½ uᵀKu of the condensed
-    /// state is ½ u_bᵀ S u_b).
-    fn correct(
-        &mut self,
-        _model: &Model,
-        _history: &mut crate::contact::force::ContactState,
-        _t_next: f64,
-        _dt: f64,
-        _u_prev: &[f64],
-        _u: &[f64],
-        u_next: &mut [f64],
-    ) -> Result<CorrectionInfo, StepError> {
+    /// done (the condensed unknowns carry no load, and the strain energy ½ uᵀKu of the
+    /// condensed state is ½ u_bᵀ S u_b).
+    fn correct(&mut self, _model: &Model, _history: &mut H, _step: &StepContext<'_>, u_next: &mut [f64]) -> Result<ConstraintInfo, StepError> {
         self.condense_into(u_next);
-        Ok(CorrectionInfo::default())
-    }
-}
-
-/// Two corrections in order: the first (the dynamic contact force) then the second (the
-/// condensation, which must see the corrected interface).
-pub struct CorrectionPair<'a, 'b> {
-    pub first: &'a mut dyn Correction,
-    pub second: &'b mut dyn Correction,
-}
-
-impl Correction for CorrectionPair<'_, '_> {
-    fn correct(
-        &mut self,
-        model: &Model,
-        history: &mut crate::contact::force::ContactState,
-        t_next: f64,
-        dt: f64,
-        u_prev: &[f64],
-        u: &[f64],
-        u_next: &mut [f64],
-    ) -> Result<CorrectionInfo, StepError> {
-        let a = self.first.correct(model, history, t_next, dt, u_prev, u, u_next)?;
-        let b = self.second.correct(model, history, t_next, dt, u_prev, u, u_next)?;
-        Ok(CorrectionInfo { work: a.work + b.work, iterations: a.iterations.max(b.iterations) })
+        Ok(ConstraintInfo::default())
     }
 }

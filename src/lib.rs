@@ -23,6 +23,7 @@
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages.
 
+pub mod constraint;
 pub mod contact;
 pub mod dynamics;
 pub mod error;
@@ -34,10 +35,13 @@ pub mod mesh;
 pub mod model;
 pub mod output;
 pub mod pipeline;
+pub mod problem;
 pub mod report;
 pub mod reservoir;
 pub mod rigid;
 pub mod scene;
+pub mod simulation;
 pub mod study;
+pub mod vtk;
 
 pub use error::{Error, Result};

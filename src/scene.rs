@@ -388,14 +388,14 @@ pub struct JointSceneSpec {
     pub tolerance: Option<f64>,
     /// Contact method: "nts" (default) or "ntn" or "penalty".
     #[serde(default)]
-    pub method: Option<String>,
+    pub method: Option<ContactMethod>,
     /// Candidate layer: 1 (default) or 2.
     #[serde(default)]
     pub layer: Option<u8>,
     /// When a projection leaves the candidate set: "widen" (default) or "report".
     #[serde(default)]
-    pub on_exit: Option<String>,
-    /// Friction coefficient μ [-]. Default 0.6.
+    pub on_exit: Option<OnExitSpec>,
+    /// Friction coefficient μ [-]. Default 0.6 ([`DEFAULT_FRICTION`]); give `mu` or `phi`.
     #[serde(default)]
     pub mu: Option<f64>,
     /// Friction angle [deg] (instead of mu).
@@ -428,6 +428,99 @@ pub struct JointSceneSpec {
     /// Penalty stiffness per unit area [Pa/m] for method "penalty".
     #[serde(default)]
     pub penalty_stiffness: Option<f64>,
+}
+
+/// A joint's contact method as written in a scene (`"nts"`, `"ntn"`, `"penalty"`), checked when
+/// the scene is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactMethod {
+    /// Node-to-segment, dynamic contact force (the default).
+    Nts,
+    /// Node-to-node with the tagger's nearest master node O.
+    Ntn,
+    /// Node-to-segment geometry with penalty springs (`penalty_stiffness`).
+    Penalty,
+}
+
+impl ContactMethod {
+    /// The scene's spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ContactMethod::Nts => "nts",
+            ContactMethod::Ntn => "ntn",
+            ContactMethod::Penalty => "penalty",
+        }
+    }
+}
+
+impl std::str::FromStr for ContactMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "nts" => Ok(ContactMethod::Nts),
+            "ntn" => Ok(ContactMethod::Ntn),
+            "penalty" => Ok(ContactMethod::Penalty),
+            other => Err(format!("contact method \"{other}\" is not one of \"nts\", \"ntn\", \"penalty\"")),
+        }
+    }
+}
+
+/// What to do when a slave node's projection leaves its candidate set (`"widen"`, `"report"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OnExitSpec {
+    Widen,
+    Report,
+}
+
+/// Friction coefficient of a joint that gives neither `mu` nor `phi`. Default 0.6 (φ ≈ 31°, the
+/// middle of the range of rock joints and concrete lift joints; the seed paper's joints).
+pub const DEFAULT_FRICTION: f64 = 0.6;
+
+/// A joint's friction as the scene gives it: the one rule for μ or φ (both given is an error,
+/// checked in [`Scene::validate`]; neither: μ = [`DEFAULT_FRICTION`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Friction {
+    /// Coefficient μ [-].
+    Mu(f64),
+    /// Angle φ [deg].
+    Phi(f64),
+}
+
+impl Friction {
+    /// μ = tan φ [-].
+    pub fn mu(self) -> f64 {
+        match self {
+            Friction::Mu(m) => m,
+            Friction::Phi(p) => p.to_radians().tan(),
+        }
+    }
+
+    /// φ = atan μ [deg].
+    pub fn phi_deg(self) -> f64 {
+        match self {
+            Friction::Mu(m) => m.atan().to_degrees(),
+            Friction::Phi(p) => p,
+        }
+    }
+}
+
+impl JointSceneSpec {
+    /// The joint's friction (see [`Friction`]); call on a validated scene (both `mu` and `phi`
+    /// given reads as `mu`).
+    pub fn friction(&self) -> Friction {
+        match (self.mu, self.phi) {
+            (Some(m), _) => Friction::Mu(m),
+            (None, Some(p)) => Friction::Phi(p),
+            (None, None) => Friction::Mu(DEFAULT_FRICTION),
+        }
+    }
+
+    /// The joint's contact method (default node-to-segment).
+    pub fn method(&self) -> ContactMethod {
+        self.method.unwrap_or(ContactMethod::Nts)
+    }
 }
 
 impl Scene {
@@ -545,6 +638,11 @@ impl Scene {
         }
         if self.output.frame_stride == Some(0) {
             return Err("output.frame_stride must be at least 1".into());
+        }
+        for j in &self.joints {
+            if j.mu.is_some() && j.phi.is_some() {
+                return Err(format!("joint \"{}\": give `mu` or `phi`, not both", j.name));
+            }
         }
         self.damping.coefficients()?;
         if let Some(r) = &self.reservoir {

@@ -28,96 +28,12 @@
 
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force_with_inverse, penalty_force, JointLaw, PairHistory, PairState};
+pub use super::state::{ContactState, JointRecord, PairRecord, SearchEvents};
 use super::query::{project_along_on_quad_from, project_along_on_tri, select_projection, Location, INSIDE_TOL_DEFAULT};
-use crate::dynamics::{Correction, CorrectionInfo};
+use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
 use crate::model::Model;
 use nalgebra::{Vector2, Vector3};
-
-/// What changes for one pair (slave node) from step to step.
-#[derive(Clone, Copy, Debug)]
-pub struct PairRecord {
-    pub hist: PairHistory,
-    pub state: PairState,
-    /// Master-local node around which candidate faces are taken (starts at the tagger's O).
-    pub center: u32,
-    /// Master face of the last projection (−1: none) and the local coordinates on it.
-    pub face: i32,
-    pub xi: [f64; 2],
-    /// Gap at the end of the last step [m] (NaN when the node found no face).
-    pub gap: f64,
-    /// Normal (compressive, N) and tangential (N, in t1/t2) force of the last step.
-    pub r_n: f64,
-    pub r_t: [f64; 2],
-    /// Accumulated relative tangential displacement vector d_t (t1, t2) [m].
-    pub d_t: [f64; 2],
-    /// Accumulated tangential relative path Σ|Δd_t| [m] (the joint's slip).
-    pub slip: f64,
-}
-
-/// Counters of search events per joint.
-#[derive(Clone, Debug, Default, serde::Serialize)]
-pub struct SearchEvents {
-    /// Projections found only in Layer2 after leaving Layer1.
-    pub widened_layer2: u64,
-    /// Fresh nearest-node searches (the centre moved).
-    pub fresh_searches: u64,
-    /// Times the centre of a candidate set moved to follow its slave node (`widen` only).
-    pub recentred: u64,
-    /// Node-steps with no master face found (force-free that step).
-    pub lost: u64,
-    /// Quad projections that did not converge (the face was skipped).
-    pub projection_failures: u64,
-    /// Node-steps kept in contact by the joint's `edge_tolerance`: the node was just outside the
-    /// master surface's edge, its weights extrapolated.
-    pub perimeter_kept: u64,
-}
-
-
-/// Contact history of one joint.
-#[derive(Clone, Debug, Default)]
-pub struct JointRecord {
-    pub pairs: Vec<PairRecord>,
-    pub events: SearchEvents,
-    /// Gauss–Seidel sweeps of the last step and the largest so far.
-    pub sweeps: usize,
-    pub max_sweeps: usize,
-    /// Steps whose Gauss–Seidel did not reach the tolerance.
-    pub unconverged_steps: u64,
-}
-
-/// Contact history of all joints (part of the run's `State`).
-#[derive(Clone, Debug, Default)]
-pub struct ContactState {
-    pub joints: Vec<JointRecord>,
-}
-
-impl ContactState {
-    pub fn new(joints: &[ContactJoint]) -> ContactState {
-        ContactState {
-            joints: joints
-                .iter()
-                .map(|j| JointRecord {
-                    pairs: (0..j.tag.n_slave())
-                        .map(|i| PairRecord {
-                            hist: PairHistory::default(),
-                            state: PairState::Open,
-                            center: j.tag.nearest[i],
-                            face: -1,
-                            xi: [0.0; 2],
-                            gap: f64::NAN,
-                            r_n: 0.0,
-                            r_t: [0.0; 2],
-                            d_t: [0.0; 2],
-                            slip: 0.0,
-                        })
-                        .collect(),
-                    ..Default::default()
-                })
-                .collect(),
-        }
-    }
-}
 
 /// Per model node: where it is among the nodes of this step's active pairs.
 #[derive(Clone, Copy, Debug, Default)]
@@ -258,7 +174,11 @@ pub struct ContactSolver<'m> {
     /// The Gauss–Seidel order of the active pairs (indices into `active`).
     order: Vec<u32>,
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
+    /// Per node 1/m for the pair mobilities (0 at a node with a fixed component or without
+    /// inertia; at a block node its largest inverse mass).
     inv_mass: Vec<f64>,
+    /// The free nodes with a 3×3 inertia block, ascending (empty for most models).
+    block_nodes: Vec<u32>,
     cand: Vec<u32>,
     /// Per model node, its place among the local nodes (see [`NodeScratch`]).
     node: Vec<NodeScratch>,
@@ -277,10 +197,18 @@ pub struct ContactSolver<'m> {
 impl<'m> ContactSolver<'m> {
     pub fn new(model: &Model, joints: &'m [ContactJoint]) -> ContactSolver<'m> {
         let size = joints.iter().map(|j| j.tag.size).fold(0.0, f64::max);
-        let inv_mass = (0..model.n_nodes())
-            .map(|n| if model.fixed[n] == 0 && model.mass[n] > 0.0 { 1.0 / model.mass[n] } else { 0.0 })
+        let mass = &model.mass;
+        let mut inv_mass: Vec<f64> = (0..model.n_nodes())
+            .map(|n| if model.fixed[n] == 0 && mass.inertial[n] > 0.0 { 1.0 / mass.inertial[n] } else { 0.0 })
             .collect();
-        ContactSolver { joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        // a block node: its largest inverse mass (for the penalty bound and the colouring's
+        // test of a moving node); the pairs read it along their normal (`inverse_mass_along`)
+        let block_nodes: Vec<u32> = mass.blocks.iter().filter(|b| model.fixed[b.node as usize] == 0).map(|b| b.node).collect();
+        for b in &mass.blocks {
+            let n = b.node as usize;
+            inv_mass[n] = if model.fixed[n] == 0 { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
+        }
+        ContactSolver { block_nodes, joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -301,6 +229,19 @@ impl<'m> ContactSolver<'m> {
             }
         }
         row.into_iter().fold(0.0, f64::max)
+    }
+
+    /// The inverse mass a pair with normal `n` reads at `node` [1/kg]: 1/m (0 at a fixed node),
+    /// or at a node with an inertia block n · M⁻¹ n, its inverse mass along the pair's normal
+    /// (docs/contact.md, "Mobility of an anisotropic mass"). One test of an empty list for the
+    /// models without blocks.
+    #[inline(always)]
+    fn inverse_mass_along(&self, model: &Model, node: usize, n: &Vector3<f64>) -> f64 {
+        if self.block_nodes.is_empty() || self.block_nodes.binary_search(&(node as u32)).is_err() {
+            self.inv_mass[node]
+        } else {
+            model.mass.inverse_along(node, n)
+        }
     }
 
     /// The joint's law as it applies now: with [`Self::keep_bonds`] its bond is kept.
@@ -715,9 +656,12 @@ impl ContactSolver<'_> {
                         }
                     }
                 };
-                let mut w = self.inv_mass[s];
+                let ims = self.inverse_mass_along(model, s, &n);
+                let mut imm = [0.0; 4];
+                let mut w = ims;
                 for a in 0..nm as usize {
-                    w += weights[a] * weights[a] * self.inv_mass[masters[a] as usize];
+                    imm[a] = self.inverse_mass_along(model, masters[a] as usize, &n);
+                    w += weights[a] * weights[a] * imm[a];
                 }
                 if w == 0.0 {
                     continue;
@@ -767,14 +711,13 @@ impl ContactSolver<'_> {
                 let mut nodes5 = [s as u32; 5];
                 let mut coef = [-1.0, 0.0, 0.0, 0.0, 0.0];
                 let mut mob = [0.0; 5];
-                if self.inv_mass[s] > 0.0 {
-                    mob[0] = dt2 * self.inv_mass[s];
+                if ims > 0.0 {
+                    mob[0] = dt2 * ims;
                 }
                 for b in 0..nm as usize {
-                    let mi = masters[b] as usize;
                     nodes5[b + 1] = masters[b];
                     coef[b + 1] = weights[b];
-                    let imi = self.inv_mass[mi];
+                    let imi = imm[b];
                     if imi > 0.0 {
                         mob[b + 1] = -dt2 * weights[b] * imi;
                     }
@@ -962,17 +905,9 @@ impl ContactSolver<'_> {
     }
 }
 
-impl Correction for ContactSolver<'_> {
-    fn correct(
-        &mut self,
-        model: &Model,
-        history: &mut ContactState,
-        _t_next: f64,
-        dt: f64,
-        u_prev: &[f64],
-        u: &[f64],
-        u_next: &mut [f64],
-    ) -> Result<CorrectionInfo, StepError> {
+impl Constraint<ContactState> for ContactSolver<'_> {
+    fn correct(&mut self, model: &Model, history: &mut ContactState, step: &StepContext<'_>, u_next: &mut [f64]) -> Result<ConstraintInfo, StepError> {
+        let (dt, u_prev, u) = (step.dt, step.u_prev, step.u);
         let dt2 = dt * dt;
         let now_if = |on: bool| on.then(std::time::Instant::now);
         let timed = self.timings.is_some();
@@ -991,6 +926,6 @@ impl Correction for ContactSolver<'_> {
             t.record += d.elapsed();
             t.steps += 1;
         }
-        Ok(CorrectionInfo { work, iterations: sweeps })
+        Ok(ConstraintInfo { work, iterations: sweeps })
     }
 }

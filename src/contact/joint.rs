@@ -1,12 +1,15 @@
 //! A joint ready for contact mechanics: the tagged interface, its law, method and options.
-//! Built once with the model, never mutated.
+//! The joints are their own stage ([`build_joints`]): tagged once from the mesh, never
+//! re-tagged; a strength-reduction trial changes only their laws ([`ContactJoint::law`]).
 
 use super::law::{JointLaw, OPEN_TOLERANCE_RELATIVE};
 use crate::error::{Error, ModelError};
 use crate::interface::{tag_joint, Joint, JointSpec};
 use crate::mesh::Mesh;
-use crate::scene::JointSceneSpec;
+use crate::scene::{ContactMethod, JointSceneSpec, OnExitSpec, Scene};
 use nalgebra::Vector3;
+
+pub use super::query::tangent_frame;
 
 /// How pairs are formed and forced.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -45,31 +48,11 @@ pub struct ContactJoint {
     pub frames: Vec<[Vector3<f64>; 3]>,
 }
 
-/// A deterministic orthonormal completion (t1, t2) of a unit normal n.
-pub fn tangent_frame(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    // pick the axis least aligned with n
-    let a = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
-        Vector3::x()
-    } else if n.y.abs() <= n.z.abs() {
-        Vector3::y()
-    } else {
-        Vector3::z()
-    };
-    let t1 = (a - n * n.dot(&a)).normalize();
-    let t2 = n.cross(&t1);
-    (t1, t2)
-}
-
 impl ContactJoint {
     /// Tag a scene joint on the mesh and resolve its law and options.
     pub fn build(mesh: &Mesh, spec: &JointSceneSpec, model_size: f64) -> Result<ContactJoint, Error> {
         let bad = |m: String| -> Error { ModelError::Invalid(format!("joint \"{}\": {m}", spec.name)).into() };
-        let mu = match (spec.mu, spec.phi) {
-            (Some(_), Some(_)) => return Err(bad("give `mu` or `phi`, not both".into())),
-            (Some(m), None) => m,
-            (None, Some(p)) => p.to_radians().tan(),
-            (None, None) => 0.6,
-        };
+        let mu = spec.friction().mu();
         let mut law = JointLaw {
             mu,
             cohesion: spec.cohesion.unwrap_or(0.0),
@@ -80,26 +63,24 @@ impl ContactJoint {
             softening_slip: spec.softening_slip.unwrap_or(0.0),
         };
         law.validate().map_err(|e| bad(e.to_string()))?;
-        let method = match spec.method.as_deref().unwrap_or("nts") {
-            "nts" => Method::Nts,
-            "ntn" => Method::Ntn,
-            "penalty" => {
+        let method = match spec.method() {
+            ContactMethod::Nts => Method::Nts,
+            ContactMethod::Ntn => Method::Ntn,
+            ContactMethod::Penalty => {
                 let kn = spec.penalty_stiffness.ok_or_else(|| bad("method \"penalty\" needs `penalty_stiffness` [Pa/m]".into()))?;
                 if !(kn > 0.0 && kn.is_finite()) {
                     return Err(bad(format!("penalty_stiffness = {kn} must be positive [Pa/m]")));
                 }
                 Method::Penalty { kn, kt: kn }
             }
-            other => return Err(bad(format!("method \"{other}\" is not one of \"nts\", \"ntn\", \"penalty\""))),
         };
         let layer = spec.layer.unwrap_or(1);
         if layer != 1 && layer != 2 {
             return Err(bad(format!("layer = {layer} must be 1 or 2")));
         }
-        let on_exit = match spec.on_exit.as_deref().unwrap_or("widen") {
-            "widen" => OnExit::Widen,
-            "report" => OnExit::Report,
-            other => return Err(bad(format!("on_exit \"{other}\" is not \"widen\" or \"report\""))),
+        let on_exit = match spec.on_exit.unwrap_or(OnExitSpec::Widen) {
+            OnExitSpec::Widen => OnExit::Widen,
+            OnExitSpec::Report => OnExit::Report,
         };
         let edge_tolerance = spec.edge_tolerance.unwrap_or(1e-3);
         if !(edge_tolerance > 0.0 && edge_tolerance < 0.5) {
@@ -122,4 +103,12 @@ impl ContactJoint {
             .collect();
         Ok(ContactJoint { tag, law, method, layer, on_exit, edge_tolerance, frames })
     }
+}
+
+/// The joints stage: tag every joint of the scene on the mesh (once, on the initial
+/// configuration) and resolve its law and options, in scene order. The default tagging
+/// tolerance is 1e-6 × the mesh's bounding-box diagonal.
+pub fn build_joints(mesh: &Mesh, scene: &Scene) -> Result<Vec<ContactJoint>, Error> {
+    let size = mesh.diagonal();
+    scene.joints.iter().map(|js| ContactJoint::build(mesh, js, size)).collect()
 }

@@ -42,3 +42,6 @@ pub mod force;
 pub mod joint;
 pub mod law;
 pub mod query;
+pub mod state;
+
+pub use state::ContactState;

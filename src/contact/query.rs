@@ -386,7 +386,7 @@ fn quad_local_analytic(
     n: &Vector3<f64>,
     h: f64,
 ) -> Result<Option<[f64; 2]>, &'static str> {
-    let (t1, t2) = tangents(n);
+    let (t1, t2) = tangent_frame(n);
     let proj = |v: &Vector3<f64>| Vector2::new(t1.dot(v), t2.dot(v));
     let (a, b, c, d) = (proj(&q.c12), proj(&q.c1), proj(&q.c2), proj(&(q.c0 - xs)));
     // (A1 ξ2 + B1)(C2 ξ2 + D2) − (A2 ξ2 + B2)(C1 ξ2 + D1) = 0
@@ -447,17 +447,19 @@ fn quad_local_analytic(
     }
 }
 
-/// An orthonormal pair `(t1, t2)` completing the unit vector `n` to a right-handed frame.
-fn tangents(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
-    // Cross with the axis least aligned with n.
-    let axis = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
+/// The tangent frame of a unit normal `n`: a deterministic orthonormal pair `(t1, t2)` with
+/// `(n, t1, t2)` right-handed. `t1` is the axis least aligned with `n` (x before y before z on a
+/// tie) with its component along `n` removed, normalised; `t2 = n × t1`. The one frame rule of
+/// the crate: the pairs' local frames and the quad projection's analytic solve use it.
+pub fn tangent_frame(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let a = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
         Vector3::x()
     } else if n.y.abs() <= n.z.abs() {
         Vector3::y()
     } else {
         Vector3::z()
     };
-    let t1 = n.cross(&axis).normalize();
+    let t1 = (a - n * n.dot(&a)).normalize();
     let t2 = n.cross(&t1);
     (t1, t2)
 }

@@ -2,7 +2,8 @@
 //!
 //! Relative form: with the base moving with acceleration a_g(t), the displacements solved for are
 //! relative to the base, fixed boundary nodes have relative displacement 0, and every node with
-//! mass carries the effective force −m a_g(t). Records are already in m/s² ([`super::record`]).
+//! inertia carries the effective force −M a_g(t) (inertial mass, added inertia included);
+//! gravity acts on the gravitational mass (`model::mass`). Records are already in m/s² ([`super::record`]).
 
 use super::record::Record;
 use crate::error::{Error, ModelError};
@@ -129,13 +130,6 @@ impl Loads {
             notes.push(format!("nodal force at ({:?}) snapped to node {} at distance {:.3e} m", nf.point, model.mesh.node_tags[node], dist));
             patterns.push(ForcePattern { forces: vec![(node, nf.force)], ramp: nf.ramp });
         }
-        // nodes that carry mass but no weight (the layer of a massless block along a joint)
-        if model.weightless.iter().any(|&w| w) {
-            let mask = gravity_nodes.get_or_insert_with(|| vec![true; model.n_nodes()]);
-            for (m, &w) in mask.iter_mut().zip(&model.weightless) {
-                *m &= !w;
-            }
-        }
         let mut static_forces = Vec::new();
         if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic) {
             let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
@@ -146,7 +140,7 @@ impl Loads {
             let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
             static_forces = crate::reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
             let total: f64 = static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
-            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N), added mass on {} nodes (Σ m_a {:.4e} kg)", spec.level, spec.depth(), static_forces.len(), total, model.added_mass.len(), model.added_mass.iter().map(|a| a.mass).sum::<f64>()));
+            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), static_forces.len(), total));
         }
         Ok((Loads { gravity, gravity_nodes, base, patterns, static_forces }, notes))
     }
@@ -166,29 +160,37 @@ impl Loads {
     pub fn external_force_into(&self, model: &Model, t: f64, with_gravity: bool, with_dynamic: bool, f: &mut [f64]) {
         let g = if with_gravity { self.gravity.unwrap_or([0.0; 3]) } else { [0.0; 3] };
         let ag = if with_dynamic { self.ground_acceleration(t) } else { [0.0; 3] };
-        for (n, &m) in model.mass.iter().enumerate() {
+        let mass = &model.mass;
+        for (n, (&m, &mg)) in mass.inertial.iter().zip(&mass.gravitational).enumerate() {
             let w = match &self.gravity_nodes {
                 Some(mask) if !mask[n] => 0.0,
                 _ => 1.0,
             };
-            f[3 * n] = m * (w * g[0] - ag[0]);
-            f[3 * n + 1] = m * (w * g[1] - ag[1]);
-            f[3 * n + 2] = m * (w * g[2] - ag[2]);
+            if m == mg {
+                f[3 * n] = m * (w * g[0] - ag[0]);
+                f[3 * n + 1] = m * (w * g[1] - ag[1]);
+                f[3 * n + 2] = m * (w * g[2] - ag[2]);
+            } else {
+                // weight and inertia apart: m_g g − m a_g
+                f[3 * n] = mg * w * g[0] - m * ag[0];
+                f[3 * n + 1] = mg * w * g[1] - m * ag[1];
+                f[3 * n + 2] = mg * w * g[2] - m * ag[2];
+            }
+        }
+        if with_dynamic && ag != [0.0; 3] {
+            // the added inertia's base force −A a_g (no weight)
+            let agv = Vector3::from(ag);
+            for b in &mass.blocks {
+                let fb = b.added * agv;
+                for c in 0..3 {
+                    f[3 * b.node as usize + c] -= fb[c];
+                }
+            }
         }
         if with_gravity {
             for &(n, fv) in &self.static_forces {
                 for i in 0..3 {
                     f[3 * n + i] += fv[i];
-                }
-            }
-        }
-        if with_dynamic && ag != [0.0; 3] {
-            // the added mass takes part in the inertial base force: −m_a n (n · a_g)
-            for a in &model.added_mass {
-                let n = a.normal;
-                let na = n[0] * ag[0] + n[1] * ag[1] + n[2] * ag[2];
-                for i in 0..3 {
-                    f[3 * a.node + i] -= a.mass * n[i] * na;
                 }
             }
         }

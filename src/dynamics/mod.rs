@@ -7,8 +7,11 @@
 //! ```
 //!
 //! so u[n+1] = 2u[n] − u[n−1] + dt² M⁻¹ (F[n] − K (u[n] + β v_b) − α M v_b) with
-//! v_b = (u[n] − u[n−1]) / dt, followed by the contact correction u[n+1] += dt² M⁻¹ R
-//! ([`Correction`]). Fixed components keep relative displacement 0.
+//! v_b = (u[n] − u[n−1]) / dt, followed by the constraints' corrections (the dynamic contact
+//! force u[n+1] += dt² M⁻¹ R, and any other [`Constraint`]). Fixed components keep relative
+//! displacement 0; a node without inertia is left at 0 by the prediction, for a constraint to
+//! set. M is the inertial mass (`model::mass`): diagonal, except at the few block nodes, which a
+//! second pass redoes with their 3×3 inverse.
 //!
 //! Owns: [`State`] (what changes: t, u[n], u[n−1], energy account) and [`ExplicitSolver`]
 //! (scratch buffers only). Energy: E_err = KE + SE + D_α + D_β − E0 − W_ext − W_contact in the
@@ -17,7 +20,10 @@
 
 pub mod loads;
 pub mod record;
+pub mod time;
 
+pub use crate::constraint::{Constraint, ConstraintInfo, StepContext};
+use crate::contact::ContactState;
 use crate::error::StepError;
 use crate::model::Model;
 use loads::Loads;
@@ -76,7 +82,7 @@ fn for_each_entry(v: &mut [f64], f: impl Fn(usize, &mut f64) + Sync + Send) {
 }
 
 /// Running energy account of the dynamic stage [J].
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energy {
     pub kinetic: f64,
     pub strain: f64,
@@ -107,53 +113,52 @@ pub struct State {
     pub u_prev: Vec<f64>,
     pub energy: Energy,
     /// Contact history of every joint (empty without joints).
-    pub contact: crate::contact::force::ContactState,
+    pub contact: ContactState,
 }
 
 impl State {
-    pub fn at_rest(model: &Model) -> State {
+    /// At rest at t = 0, with the contact history `contact` (`ContactState::new(&joints)`, or
+    /// the default without joints).
+    pub fn at_rest(model: &Model, contact: ContactState) -> State {
         let n = 3 * model.n_nodes();
-        State {
-            step: 0,
-            t: 0.0,
-            u: vec![0.0; n],
-            u_prev: vec![0.0; n],
-            energy: Energy::default(),
-            contact: crate::contact::force::ContactState::new(&model.joints),
-        }
+        State { step: 0, t: 0.0, u: vec![0.0; n], u_prev: vec![0.0; n], energy: Energy::default(), contact }
     }
 }
 
-/// Result of a contact (or other constraint) correction of one step.
-#[derive(Clone, Debug, Default)]
-pub struct CorrectionInfo {
-    /// Work of the correction forces over the step, Δu_c · R [J].
-    pub work: f64,
-    /// Gauss–Seidel sweeps used.
-    pub iterations: usize,
+/// The constraints of a step, applied in order after the prediction (empty: none).
+pub type Constraints<'a, 'c> = &'a mut [&'c mut dyn Constraint<ContactState>];
+
+/// Central differences at t[n] from u[n−1], u[n], u[n+1]: the one rule for velocity and
+/// acceleration in outputs, monitors and peaks (the scheme's own, design §4).
+#[derive(Clone, Copy, Debug)]
+pub struct Kinematics<'a> {
+    /// t[n] [s] and the step [s].
+    pub t: f64,
+    pub dt: f64,
+    pub u_prev: &'a [f64],
+    pub u: &'a [f64],
+    pub u_next: &'a [f64],
 }
 
-/// A correction applied to the contact-free prediction u[n+1] (the dynamic contact force).
-pub trait Correction {
-    /// `u_prev` = u[n−1], `u` = u[n], `u_next` = predicted u[n+1] (corrected in place);
-    /// `history` is the contact part of the state, updated in place.
-    #[allow(clippy::too_many_arguments)]
-    fn correct(
-        &mut self,
-        model: &Model,
-        history: &mut crate::contact::force::ContactState,
-        t_next: f64,
-        dt: f64,
-        u_prev: &[f64],
-        u: &[f64],
-        u_next: &mut [f64],
-    ) -> Result<CorrectionInfo, StepError>;
+impl Kinematics<'_> {
+    /// v[n] = (u[n+1] − u[n−1]) / 2dt of entry `i` [m/s].
+    #[inline]
+    pub fn velocity(&self, i: usize) -> f64 {
+        (self.u_next[i] - self.u_prev[i]) / (2.0 * self.dt)
+    }
+
+    /// a[n] = (u[n+1] − 2u[n] + u[n−1]) / dt² of entry `i` [m/s²].
+    #[inline]
+    pub fn acceleration(&self, i: usize) -> f64 {
+        (self.u_next[i] - 2.0 * self.u[i] + self.u_prev[i]) / (self.dt * self.dt)
+    }
 }
 
 /// Non-fatal information about one step.
 #[derive(Clone, Debug, Default)]
 pub struct StepInfo {
-    pub correction: CorrectionInfo,
+    /// The constraints' corrections of the step, summed.
+    pub correction: ConstraintInfo,
 }
 
 /// Which loads a step applies.
@@ -211,14 +216,7 @@ impl ExplicitSolver {
     }
 
     /// Advance `state` from t[n] to t[n+1].
-    pub fn step<'c>(
-        &mut self,
-        model: &Model,
-        loads: &Loads,
-        state: &mut State,
-        stage: Stage,
-        correction: Option<&mut (dyn Correction + 'c)>,
-    ) -> Result<StepInfo, StepError> {
+    pub fn step(&mut self, model: &Model, loads: &Loads, state: &mut State, stage: Stage, constraints: Constraints<'_, '_>) -> Result<StepInfo, StepError> {
         let dt = self.dt;
         let dynamic = stage == Stage::Dynamic;
         loads.external_force_into(model, state.t, true, dynamic, &mut self.f_ext);
@@ -260,21 +258,22 @@ impl ExplicitSolver {
                     }
                     if alpha > 0.0 && model.mass_damped[i / 3] {
                         let vb = (state.u[i] - state.u_prev[i]) / dt;
-                        damp += du * alpha * model.mass[i / 3] * vb;
+                        damp += du * alpha * model.mass.inertial[i / 3] * vb;
                     }
                 }
             }
             [wext, damp, sdamp, finite]
         };
-        // the update, one block of nodes per task; with no correction the increments are taken
-        // in the same pass (u[n+1] is final)
-        let fused = correction.is_none() && model.added_mass.is_empty();
+        // the update, one block of nodes per task; with no constraint and no block node the
+        // increments are taken in the same pass (u[n+1] is final)
+        let blocks = &model.mass.blocks;
+        let fused = constraints.is_empty() && blocks.is_empty();
         let parts: Vec<[f64; 4]> = map_blocks_mut(&mut self.u_next, |b, un| {
             let first = b * NODE_BLOCK;
             for (k, unode) in un.chunks_exact_mut(3).enumerate() {
                 let node = first + k;
-                let m = model.mass[node];
-                let fx = model.fixed[node];
+                let m = model.mass.inertial[node];
+                let fx = model.held[node];
                 for c in 0..3 {
                     let i = 3 * node + c;
                     if fx & (1 << c) != 0 {
@@ -289,33 +288,43 @@ impl ExplicitSolver {
             }
             if fused { increments(3 * first..3 * first + un.len(), un) } else { [0.0; 4] }
         });
-        // wet nodes: the 3×3 inertia m I + m_a n nᵀ of the reservoir's added mass (the scalar
-        // update above used m alone); αM damps the structural mass only
-        for a in &model.added_mass {
-            let node = a.node;
+        // block nodes: a = M⁻¹ (F − K u) − α v_b with their full inverse (on free components)
+        for b in blocks {
+            let node = b.node as usize;
+            let i0 = 3 * node;
+            let f = nalgebra::Vector3::from_fn(|c, _| self.f_ext[i0 + c] - self.f_int[i0 + c]);
+            let a = b.inverse * f;
             let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
-            let m = model.mass[node];
-            let r: [f64; 3] = std::array::from_fn(|c| {
-                let i = 3 * node + c;
-                self.f_ext[i] - self.f_int[i] - an * m * (state.u[i] - state.u_prev[i]) / dt
-            });
             for c in 0..3 {
-                let i = 3 * node + c;
-                if model.fixed[node] & (1 << c) != 0 {
-                    continue;
-                }
-                let acc = a.inverse[c][0] * r[0] + a.inverse[c][1] * r[1] + a.inverse[c][2] * r[2];
-                self.u_next[i] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * acc;
+                let i = i0 + c;
+                self.u_next[i] = if model.held[node] & (1 << c) != 0 {
+                    0.0
+                } else {
+                    let vb = (state.u[i] - state.u_prev[i]) / dt;
+                    2.0 * state.u[i] - state.u_prev[i] + dt2 * (a[c] - an * vb)
+                };
             }
         }
         let mut info = StepInfo::default();
-        let sums = if let Some(c) = correction {
-            info.correction = c.correct(model, &mut state.contact, state.t + dt, dt, &state.u_prev, &state.u, &mut self.u_next)?;
-            sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]))
-        } else if fused {
+        let sums = if fused {
             add_parts(&parts)
         } else {
-            sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]))
+            let ctx = StepContext { t_next: state.t + dt, dt, u_prev: &state.u_prev, u: &state.u };
+            for c in constraints.iter_mut() {
+                let ci = c.correct(model, &mut state.contact, &ctx, &mut self.u_next)?;
+                info.correction = std::mem::take(&mut info.correction).merged(ci);
+            }
+            let mut s = sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]));
+            if dynamic && alpha > 0.0 {
+                // mass damping of the added inertia A: Δu_c · α A v_b
+                for b in blocks.iter().filter(|b| model.mass_damped[b.node as usize]) {
+                    let i0 = 3 * b.node as usize;
+                    let du = nalgebra::Vector3::from_fn(|c, _| 0.5 * (self.u_next[i0 + c] - state.u_prev[i0 + c]));
+                    let vb = nalgebra::Vector3::from_fn(|c, _| (state.u[i0 + c] - state.u_prev[i0 + c]) / dt);
+                    s[1] += du.dot(&(b.added * vb)) * alpha;
+                }
+            }
+            s
         };
         if dynamic {
             let e = &mut state.energy;
@@ -381,23 +390,18 @@ impl ExplicitSolver {
             let (mut ke, mut se_mixed, mut se) = (0.0, 0.0, 0.0);
             for i in r {
                 let v = (state.u[i] - state.u_prev[i]) / dt;
-                ke += 0.5 * model.mass[i / 3] * v * v;
+                ke += 0.5 * model.mass.inertial[i / 3] * v * v;
                 se_mixed += 0.5 * state.u[i] * ku[i];
                 se += 0.5 * state.u_prev[i] * ku[i];
             }
             [ke, se_mixed, se]
         });
-        // the reservoir's added mass: ½ m_a (n · v)²
-        let ke = ke
-            + model
-                .added_mass
-                .iter()
-                .map(|a| {
-                    let v: [f64; 3] = std::array::from_fn(|c| (state.u[3 * a.node + c] - state.u_prev[3 * a.node + c]) / dt);
-                    let nv = a.normal[0] * v[0] + a.normal[1] * v[1] + a.normal[2] * v[2];
-                    0.5 * a.mass * nv * nv
-                })
-                .sum::<f64>();
+        // the added inertia's kinetic energy ½ vᵀ A v
+        let ke = ke + model.mass.blocks.iter().map(|b| {
+            let i0 = 3 * b.node as usize;
+            let v = nalgebra::Vector3::from_fn(|c, _| (state.u[i0 + c] - state.u_prev[i0 + c]) / dt);
+            0.5 * v.dot(&(b.added * v))
+        }).sum::<f64>();
         let e = &mut state.energy;
         e.kinetic = ke;
         e.strain = se;
@@ -446,7 +450,7 @@ impl ExplicitSolver {
 }
 
 /// Outcome of gravity equilibration.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct EquilibriumInfo {
     pub steps: usize,
     /// ‖M a‖ / ‖F_gravity‖ over free components at the end.
@@ -466,12 +470,12 @@ pub const RELAXATION_RAMP_STEPS: usize = 1000;
 /// so the lowest mode is critically damped. Gravity is ramped in over
 /// [`RELAXATION_RAMP_STEPS`] steps. Stops when the out-of-balance force ‖M a‖ (gravity,
 /// elastic and contact forces together) falls below `tol` × ‖F_gravity‖ after the ramp.
-pub fn relax_gravity<'c>(
+pub fn relax_gravity(
     model: &Model,
     loads: &Loads,
     solver: &mut ExplicitSolver,
     state: &mut State,
-    mut correction: Option<&mut (dyn Correction + 'c)>,
+    constraints: Constraints<'_, '_>,
     tol: f64,
     max_steps: usize,
 ) -> Result<EquilibriumInfo, StepError> {
@@ -486,7 +490,7 @@ pub fn relax_gravity<'c>(
     let mut alpha = 0.0;
     for k in 0..max_steps {
         let scale = ((k + 1) as f64 / RELAXATION_RAMP_STEPS as f64).min(1.0);
-        solver.step(model, loads, state, Stage::Relaxation(alpha, scale), correction.as_deref_mut())?;
+        solver.step(model, loads, state, Stage::Relaxation(alpha, scale), &mut *constraints)?;
         // after the step: u_nm1 = u[n−1], u_prev = u[n], u = u[n+1]; f_int = K u[n].
         // Out-of-balance force F − K u[n] + R[n] = M a[n] + α M v_b (contact forces included).
         let mut r2 = 0.0;
@@ -494,7 +498,7 @@ pub fn relax_gravity<'c>(
         let f_int = solver.internal_force();
         for i in 0..state.u.len() {
             if model.is_free(i / 3, i % 3) {
-                let m = model.mass[i / 3];
+                let m = model.mass.inertial[i / 3];
                 let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
                 let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
                 let r = m * (a + alpha * vb) / scale;
@@ -503,7 +507,24 @@ pub fn relax_gravity<'c>(
                 umu += m * state.u_prev[i] * state.u_prev[i];
             }
         }
-        residual = r2.sqrt() / norm_f;
+        // block nodes: the out-of-balance force is M (a + α v_b) with the full inertia
+        for b in &model.mass.blocks {
+            let i0 = 3 * b.node as usize;
+            let mut av = nalgebra::Vector3::zeros();
+            for c in 0..3 {
+                let i = i0 + c;
+                if model.is_free(i / 3, c) {
+                    let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
+                    let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
+                    let r = model.mass.inertial[i / 3] * (a + alpha * vb) / scale;
+                    r2 -= r * r;
+                    av[c] = a + alpha * vb;
+                }
+            }
+            let r = b.full * av / scale;
+            r2 += (0..3).filter(|&c| model.is_free(b.node as usize, c)).map(|c| r[c] * r[c]).sum::<f64>();
+        }
+        residual = r2.max(0.0).sqrt() / norm_f;
         if umu > 0.0 && ukb > 0.0 {
             // α = 2 ω_min, kept below the stability bound α dt < 1
             alpha = (2.0 * (ukb / umu).sqrt()).min(0.5 / dt);

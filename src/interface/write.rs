@@ -4,7 +4,7 @@
 use super::{Csr, Face, Joint};
 use crate::error::OutputError;
 use crate::mesh::{CellKind, Mesh};
-use crate::output::vtu::{Field, Grid, write_vtu};
+use crate::vtk::vtu::{Field, Grid, write_vtu};
 use serde::{Serialize, Serializer};
 use std::io::Write;
 use std::path::Path;

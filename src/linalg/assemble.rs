@@ -352,9 +352,9 @@ pub(crate) mod tests {
         }
         let (all, na) = dof_map(n, |_| true);
         let b = [[1.0, 2.0, 0.0], [2.0, 5.0, 0.0], [0.0, 0.0, 0.0]];
-        let mm = mass_matrix(&m.mass, &[(3, b)], &all, na).to_dense();
+        let mm = mass_matrix(&m.mass.inertial, &[(3, b)], &all, na).to_dense();
         assert_eq!(mm[(10, 9)], 2.0);
-        assert_eq!(mm[(10, 10)], m.mass[3] + 5.0);
-        assert_eq!(mm[(11, 11)], m.mass[3]);
+        assert_eq!(mm[(10, 10)], m.mass.inertial[3] + 5.0);
+        assert_eq!(mm[(11, 11)], m.mass.inertial[3]);
     }
 }

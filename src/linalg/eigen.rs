@@ -230,7 +230,7 @@ mod tests {
         let node = m.n_nodes() - 1;
         let nv = nalgebra::Vector3::new(0.6, 0.0, 0.8);
         let block: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| 500.0 * nv[i] * nv[j]));
-        let mff = mass_matrix(&m.mass, &[(node, block)], &map, nf);
+        let mff = mass_matrix(&m.mass.inertial, &[(node, block)], &map, nf);
         let modes = lowest_modes(&kff, &mff, &ModesOptions { count: 6, ..Default::default() }).unwrap();
         let kd = kff.to_dense();
         let md = mff.to_dense();
@@ -260,7 +260,7 @@ mod tests {
         let n = 3 * m.n_nodes();
         let (map, nf) = dof_map(n, |_| true);
         let kk = restrict(&k, &map, nf, &map, nf);
-        let mm = mass_matrix(&m.mass, &[], &map, nf);
+        let mm = mass_matrix(&m.mass.inertial, &[], &map, nf);
         let modes = lowest_modes(&kk, &mm, &ModesOptions { count: 7, shift: -1e3, ..Default::default() }).unwrap();
         for i in 0..6 {
             assert!(modes.omega2[i].abs() < 1e-6 * modes.omega2[6], "rigid mode {i}: {}", modes.omega2[i]);
@@ -281,7 +281,7 @@ mod tests {
         let n = 3 * m.n_nodes();
         let (map, nf) = dof_map(n, |d| m.is_free(d / 3, d % 3));
         let kff = restrict(&k, &map, nf, &map, nf);
-        let mff = mass_matrix(&m.mass, &[], &map, nf);
+        let mff = mass_matrix(&m.mass.inertial, &[], &map, nf);
         let modes = lowest_modes(&kff, &mff, &ModesOptions { count: 6, ..Default::default() }).unwrap();
         let (e, rho, a) = (1e9, 2000.0, b * h);
         let eb = |bl: f64, i: f64| bl * bl * (e * i / (rho * a * l.powi(4))).sqrt();

@@ -89,6 +89,22 @@ impl Mesh {
         nalgebra::Vector3::from(self.nodes[i])
     }
 
+    /// Diagonal of the bounding box of all nodes [m] (0 for an empty mesh): the model size that
+    /// relative tolerances refer to.
+    pub fn diagonal(&self) -> f64 {
+        if self.nodes.is_empty() {
+            return 0.0;
+        }
+        let (lo, hi) = self.nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(mut lo, mut hi), x| {
+            for i in 0..3 {
+                lo[i] = lo[i].min(x[i]);
+                hi[i] = hi[i].max(x[i]);
+            }
+            (lo, hi)
+        });
+        ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
+    }
+
     /// Index of the node nearest to `p` and its distance [m] (linear scan; use for a few points).
     pub fn nearest_node(&self, p: [f64; 3]) -> Option<(usize, f64)> {
         self.nodes

@@ -1,13 +1,16 @@
 //! The model: built once from the mesh and the scene, never mutated during a run.
 //!
 //! Owns: materials per volume group, element data (tet4 geometry, shared hex8 shapes),
-//! lumped nodal masses, fixed components, and the element colouring used for deterministic
-//! parallel assembly. Inputs: [`Mesh`], scene materials and boundary conditions.
+//! nodal masses ([`mass`]: inertia and weight apart), fixed components, and the element
+//! colouring used for deterministic parallel assembly. Joints are not part of the model: they
+//! are their own stage (`contact::joint::build_joints`), built once from the tagger.
+//! Inputs: [`Mesh`], scene materials and boundary conditions.
 //! Outputs: `K u` ([`Model::internal_forces_into`]), element stresses, the stable step.
 //!
 //! Invariants:
-//! - Degrees of freedom are `3 * node + component` (x, y, z), for every mesh node; nodes with
-//!   no mass (not in any material volume) are inactive and treated as fixed.
+//! - Degrees of freedom are `3 * node + component` (x, y, z), for every mesh node; nodes in no
+//!   material volume are inactive and treated as fixed. Nodes of massless elements (ρ = 0) are
+//!   active but have no inertia: the explicit step leaves them to a constraint ([`Model::held`]).
 //! - Elements are stored in assembly order ([`Schedule`]): sorted along a Morton (Z-order)
 //!   curve of their centroids, cut into chunks of consecutive elements, and the chunks grouped
 //!   by colour. No two chunks of one colour share a node, so the chunks of a colour are
@@ -19,6 +22,7 @@
 //!   M ü + C u̇ + f_int = F_ext + R.
 
 pub mod hex8;
+pub mod mass;
 pub mod material;
 pub mod tet4;
 
@@ -26,6 +30,7 @@ use crate::error::{MeshError, ModelError};
 use crate::mesh::{CellKind, Mesh};
 use crate::scene::Scene;
 use hex8::HexShape;
+use mass::NodalMass;
 use material::{Lame, Material};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -84,10 +89,13 @@ pub struct Model {
     pub materials: Vec<Material>,
     pub tets: Tet4Set,
     pub hexes: Hex8Set,
-    /// Lumped mass per node [kg] (0 = inactive node).
-    pub mass: Vec<f64>,
+    /// Inertial and gravitational mass per node ([`mass`]).
+    pub mass: NodalMass,
     /// Fixed components per node: bit 0 = x, 1 = y, 2 = z. Inactive nodes are fully fixed.
     pub fixed: Vec<u8>,
+    /// Components the explicit step does not integrate (u[n+1] = 0 in the prediction): the fixed
+    /// ones, and all three of a node without inertia (set by a constraint instead).
+    pub held: Vec<u8>,
     /// Rayleigh damping C = αM + βK: α [1/s], β [s].
     pub alpha: f64,
     /// Per node: whether αM applies in the dynamic stage (scene `damping.mass_groups`; all
@@ -95,8 +103,6 @@ pub struct Model {
     pub mass_damped: Vec<bool>,
     pub beta: f64,
     pub critical: CriticalElement,
-    /// Joints (tagged interfaces with their laws), in scene order.
-    pub joints: Vec<crate::contact::joint::ContactJoint>,
     /// Per material: a massless block (stiffness only; `crate::foundation` condenses it).
     pub massless: Vec<bool>,
     /// Per node: the components condensed statically (nodes of massless blocks without mass,
@@ -109,28 +115,6 @@ pub struct Model {
     /// Per node: carries mass but no weight (its mass comes only from the layer of a massless
     /// block's elements along a joint face: docs/dam_physics.md).
     pub weightless: Vec<bool>,
-    /// Reservoir added mass m_a n nᵀ of the wet nodes (empty without a reservoir).
-    pub added_mass: Vec<AddedInertia>,
-}
-
-/// The inertia of a wet node: m I + m_a n nᵀ, and the inverse of that 3×3 block on the node's
-/// free components (rows and columns of fixed components are 0).
-#[derive(Clone, Copy, Debug)]
-pub struct AddedInertia {
-    pub node: usize,
-    /// Added mass m_a [kg] along `normal`.
-    pub mass: f64,
-    pub normal: [f64; 3],
-    pub inverse: [[f64; 3]; 3],
-}
-
-impl AddedInertia {
-    /// M v for this node's 3×3 block (structural mass `m`).
-    pub fn apply(&self, m: f64, v: [f64; 3]) -> [f64; 3] {
-        let n = self.normal;
-        let nv = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
-        std::array::from_fn(|i| m * v[i] + self.mass * n[i] * nv)
-    }
 }
 
 /// Scatter target shared across threads. Safe use requires that no two concurrent writers touch
@@ -363,6 +347,7 @@ impl Model {
             }
         }
         let mut element_massless_cell = vec![false; mesh.cells.len()];
+        let mut active = vec![false; n];
         let inverted = |c: usize, mi: usize| -> crate::Error {
             MeshError::InvertedElement {
                 path: mesh.source.clone(),
@@ -398,6 +383,7 @@ impl Model {
                         if !massless[mi] {
                             massive_mass[cell.node(a)] += rho * g.vol / 4.0;
                         }
+                        active[cell.node(a)] = true;
                     }
                     tn.push(std::array::from_fn(|a| cell.nodes()[a]));
                     tm.push(mi as u16);
@@ -430,6 +416,7 @@ impl Model {
                         if !massless[mi] {
                             massive_mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
                         }
+                        active[cell.node(a)] = true;
                     }
                     hn.push(std::array::from_fn(|a| cell.nodes()[a]));
                     hs.push(id);
@@ -465,7 +452,7 @@ impl Model {
         drop((ho, hn, hs, hm, hc));
 
         // ---- boundary conditions
-        let mut fixed: Vec<u8> = mass.iter().map(|&m| if m > 0.0 { 0 } else { 7 }).collect();
+        let mut fixed: Vec<u8> = active.iter().map(|&a| if a { 0 } else { 7 }).collect();
         // nodes of the massless elements (without mass: condensed)
         let mut condensed = vec![0u8; n];
         for (c, &ml) in element_massless_cell.iter().enumerate() {
@@ -489,42 +476,6 @@ impl Model {
         }
         let weightless: Vec<bool> = (0..n).map(|i| mass[i] > 0.0 && massive_mass[i] == 0.0).collect();
         drop(massive_mass);
-        // ---- reservoir added mass (inertia m I + m_a n nᵀ on the wet nodes)
-        let mut added_mass = Vec::new();
-        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.added_mass) {
-            let volume: Vec<usize> = scene.materials.iter().map(|m| mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
-            let mut faces = Vec::new();
-            for g in &r.faces {
-                faces.extend(crate::reservoir::wet_faces(&mesh, g, &volume)?);
-            }
-            let spec = reservoir_spec(&mesh, r, &faces, scene);
-            for a in crate::reservoir::added_masses(&mesh, &faces, &spec) {
-                if mass[a.node] == 0.0 {
-                    return Err(ModelError::Invalid(format!(
-                        "reservoir face node {} has no structural mass (is the wet face on a massless block?): the added mass needs a massive dam face",
-                        mesh.node_tags[a.node]
-                    ))
-                    .into());
-                }
-                let nv = nalgebra::Vector3::from(a.normal);
-                let mut m3 = nalgebra::Matrix3::identity() * mass[a.node] + nv * nv.transpose() * a.mass;
-                for c in 0..3 {
-                    if fixed[a.node] & (1 << c) != 0 {
-                        m3.set_row(c, &nalgebra::RowVector3::zeros());
-                        m3.set_column(c, &nalgebra::Vector3::zeros());
-                        m3[(c, c)] = 1.0;
-                    }
-                }
-                let mut inv = m3.try_inverse().expect("m I + m_a n nᵀ is positive definite");
-                for c in 0..3 {
-                    if fixed[a.node] & (1 << c) != 0 {
-                        inv.set_row(c, &nalgebra::RowVector3::zeros());
-                        inv.set_column(c, &nalgebra::Vector3::zeros());
-                    }
-                }
-                added_mass.push(AddedInertia { node: a.node, mass: a.mass, normal: a.normal, inverse: std::array::from_fn(|i| std::array::from_fn(|j| inv[(i, j)])) });
-            }
-        }
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
         let mass_damped = match &scene.damping.mass_groups {
             None => vec![true; n],
@@ -539,39 +490,31 @@ impl Model {
                 d
             }
         };
-        // ---- joints (tagged once on the initial configuration)
-        let size = {
-            let (lo, hi) = mesh.nodes.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(mut lo, mut hi), x| {
-                for i in 0..3 {
-                    lo[i] = lo[i].min(x[i]);
-                    hi[i] = hi[i].max(x[i]);
-                }
-                (lo, hi)
-            });
-            ((hi[0] - lo[0]).powi(2) + (hi[1] - lo[1]).powi(2) + (hi[2] - lo[2]).powi(2)).sqrt()
-        };
-        let mut joints = Vec::new();
-        for js in &scene.joints {
-            joints.push(crate::contact::joint::ContactJoint::build(&mesh, js, size)?);
-        }
-
+        let held = fixed.iter().zip(&mass).map(|(&f, &m)| if m > 0.0 { f } else { 7 }).collect();
         let mut model = Model {
             mesh,
             materials,
             tets,
             hexes,
-            mass,
+            mass: {
+                let mut m = NodalMass::lumped(mass);
+                for (g, &w) in m.gravitational.iter_mut().zip(&weightless) {
+                    if w {
+                        *g = 0.0;
+                    }
+                }
+                m
+            },
             fixed,
+            held,
             alpha,
             mass_damped,
             beta,
             critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
-            joints,
             massless,
             massless_cells: element_massless_cell,
             condensed,
             weightless,
-            added_mass,
         };
         model.critical = model.max_element_eigenvalue();
         Ok(model)
@@ -588,6 +531,21 @@ impl Model {
 
     pub fn n_elements(&self) -> usize {
         self.tets.nodes.len() + self.hexes.nodes.len()
+    }
+
+    /// Add the symmetric inertia `a` [kg] (no weight) to `node`, e.g. a reservoir's added mass
+    /// m_a n nᵀ ([`NodalMass::add_inertia`]). The stable step stays that of the elements alone:
+    /// added inertia only lowers the frequencies, so the element bound remains an upper bound.
+    pub fn add_inertia(&mut self, node: usize, a: nalgebra::Matrix3<f64>) {
+        self.mass.add_inertia(node, a, self.fixed[node]);
+        if self.held[node] == 7 && self.fixed[node] != 7 {
+            self.held[node] = self.fixed[node];
+        }
+    }
+
+    /// Diagonal of the size of the mesh's bounding box [m] (0 for an empty mesh).
+    pub fn size(&self) -> f64 {
+        self.mesh.diagonal()
     }
 
     /// Whether dof (node, component) is free.
@@ -609,7 +567,9 @@ impl Model {
             .map(|e| {
                 let m = &self.materials[self.tets.mat[e] as usize];
                 let g = &self.tets.geom[e];
-                (tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame), self.tets.cell[e] as usize, self.tets.mat[e] as usize)
+                // a massless element (ρ = 0) sets no stable step: its nodes are condensed statically
+                let w = if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) } else { 0.0 };
+                (w, self.tets.cell[e] as usize, self.tets.mat[e] as usize)
             })
             .reduce(|| (0.0, 0, 0), |a, b| if b.0 > a.0 || (b.0 == a.0 && b.1 < a.1) { b } else { a });
         // shapes are shared: one eigenvalue per (shape), with the material of its first element

@@ -4,9 +4,10 @@
 //! differences at the frame time). Cell data: stress (9-component tensor), principal stresses
 //! σ1 ≥ σ2 ≥ σ3, von Mises, block id (index of the material in the scene).
 
-use super::pvd::PvdSeries;
-use super::vtu::{write_vtu, Field, Grid};
+use crate::vtk::pvd::PvdSeries;
+use crate::vtk::vtu::{write_vtu, Field, Grid};
 use crate::error::OutputError;
+use crate::dynamics::Kinematics;
 use crate::model::Model;
 use std::path::{Path, PathBuf};
 
@@ -16,29 +17,6 @@ pub struct FrameWriter {
     pub series: PvdSeries,
     blocks: Vec<i32>,
     stress: Vec<[f64; 6]>,
-}
-
-/// Kinematics at the frame time: u[n−1], u[n], u[n+1] and dt.
-pub struct Kinematics<'a> {
-    pub t: f64,
-    pub dt: f64,
-    pub u_prev: &'a [f64],
-    pub u: &'a [f64],
-    pub u_next: &'a [f64],
-}
-
-impl Kinematics<'_> {
-    /// (velocity, acceleration) at t[n] by central differences.
-    pub fn velocity_acceleration(&self) -> (Vec<f64>, Vec<f64>) {
-        let n = self.u.len();
-        let mut v = vec![0.0; n];
-        let mut a = vec![0.0; n];
-        for i in 0..n {
-            v[i] = (self.u_next[i] - self.u_prev[i]) / (2.0 * self.dt);
-            a[i] = (self.u_next[i] - 2.0 * self.u[i] + self.u_prev[i]) / (self.dt * self.dt);
-        }
-        (v, a)
-    }
 }
 
 impl FrameWriter {
@@ -58,7 +36,8 @@ impl FrameWriter {
     pub fn write(&mut self, model: &Model, k: &Kinematics) -> Result<PathBuf, OutputError> {
         let idx = self.series.len();
         let path = self.dir.join(format!("{}_{idx:05}.vtu", self.name));
-        let (v, a) = k.velocity_acceleration();
+        let v: Vec<f64> = (0..k.u.len()).map(|i| k.velocity(i)).collect();
+        let a: Vec<f64> = (0..k.u.len()).map(|i| k.acceleration(i)).collect();
         model.element_stress_into(k.u, &mut self.stress);
         let ne = self.stress.len();
         let mut tensor = Vec::with_capacity(9 * ne);

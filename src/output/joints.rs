@@ -7,9 +7,9 @@
 //! (Pa, compression positive), `shear_traction` (Pa), `state` (0 open, 1 stick, 2 slip,
 //! 3 bonded), `tributary_area` (m²).
 
-use super::pvd::PvdSeries;
-use super::vtu::{write_vtu, Field, Grid};
-use crate::contact::force::{ContactState, JointRecord};
+use crate::vtk::pvd::PvdSeries;
+use crate::vtk::vtu::{write_vtu, Field, Grid};
+use crate::contact::state::{ContactState, JointRecord};
 use crate::contact::joint::ContactJoint;
 use crate::contact::law::PairState;
 use crate::error::OutputError;
@@ -18,7 +18,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// Running maxima of one joint (for the summary).
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct JointPeaks {
     pub name: String,
     pub method: String,
@@ -39,7 +39,7 @@ pub struct JointPeaks {
     /// are not iterated), and the steps that did not reach it within the sweep budget.
     pub gs_tolerance: f64,
     pub unconverged_steps: u64,
-    pub events: crate::contact::force::SearchEvents,
+    pub events: crate::contact::state::SearchEvents,
     /// Largest slave-to-O distance (the NTN geometric error) [m].
     pub ntn_max_distance: f64,
 }

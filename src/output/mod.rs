@@ -1,14 +1,16 @@
-//! Output: VTU frames and `.pvd` series for ParaView, joint-surface files, CSV histories, summary.
+//! Output: VTU frames and `.pvd` series for ParaView (through the `vtk` leaf), joint-surface
+//! files, CSV histories, the run's [`recorder::Recorder`] (schedule, monitors, peaks, progress)
+//! and its [`summary::RunSummary`] (written and read back as `summary.json`).
 //!
 //! Owns only writing. Inputs: the immutable model/mesh and read-only views of the state.
 //! Invariants: every file is written whole (temp file + rename), and the `.pvd` is
 //! rewritten after every frame, so a run killed at any point leaves a readable series.
 
-pub mod vtu;
 pub mod frames;
 pub mod history;
 pub mod joints;
-pub mod pvd;
+pub mod recorder;
+pub mod summary;
 
 /// Principal stresses σ1 ≥ σ2 ≥ σ3 [Pa] of a Voigt stress (xx, yy, zz, xy, yz, zx).
 pub fn principal_stresses(s: &[f64; 6]) -> [f64; 3] {

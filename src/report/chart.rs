@@ -14,6 +14,7 @@ use plotters::prelude::*;
 
 use super::file::{write_atomic, write_via_temp};
 use super::font::{FAMILY, ensure_registered};
+pub use super::scale::Axis;
 use super::scale::{Window, auto_range, fmt_tick, from_axis, to_axis};
 use crate::error::ReportError;
 
@@ -61,15 +62,6 @@ const Y_LABEL_AREA: u32 = 90;
 const LIGHT_LINES: usize = 4;
 /// Offset of a point label from its marker, px, right and up, clear of the marker.
 const POINT_LABEL_OFFSET: (i32, i32) = (8, -18);
-
-/// Kind of an axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Axis {
-    #[default]
-    Linear,
-    /// Base-10 logarithmic; every value on it must be > 0.
-    Log,
-}
 
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

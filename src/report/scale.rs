@@ -6,7 +6,6 @@
 //! handled as log10 of the value, so margins, clipping and legend placement treat a decade
 //! like any other unit length.
 
-use super::chart::Axis;
 use super::table::fmt_sig;
 
 /// Margin added to each side of an automatic range, as a fraction of the data span in axis
@@ -20,6 +19,15 @@ pub const FLAT_LINEAR_HALF: f64 = 0.1;
 /// Half-width, in decades, of an automatic log range when all values are equal: half a
 /// decade each side always brackets at least one power of ten (a labelled tick).
 pub const FLAT_LOG_HALF_DECADES: f64 = 0.5;
+
+/// Kind of an axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Axis {
+    #[default]
+    Linear,
+    /// Base-10 logarithmic; every value on it must be > 0.
+    Log,
+}
 
 /// Value to axis space: identity on a linear axis, log10 on a log axis.
 pub fn to_axis(axis: Axis, v: f64) -> f64 {

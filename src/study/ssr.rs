@@ -1,19 +1,20 @@
 //! FEM strength reduction (SSR): the factor F by which c and tan φ of every joint can be
 //! divided before the model fails under gravity.
 //!
-//! Each trial F builds the model with c/F and tan φ/F on every joint (cohesion kept after slip
-//! or opening: perfectly plastic Mohr-Coulomb, the assumption of limit equilibrium) and runs gravity
-//! relaxation with contact ([`crate::dynamics::relax_gravity`]). **Failure criterion**: the
+//! The problem (model, joints tagged once, loads) is built once; each trial F sets c/F and
+//! tan φ/F on every joint's law (cohesion kept after slip or opening: perfectly plastic
+//! Mohr-Coulomb, the assumption of limit equilibrium) and runs gravity relaxation with contact
+//! on a fresh [`Simulation`] (the scene's time step, [`crate::dynamics::time::TimeStep`]). **Failure criterion**: the
 //! relaxation does not reach its residual tolerance within `max_steps`, or any slave node of
 //! the joints has slipped more than `slip_limit` (the block is sliding, not settling). F is
 //! bisected between a stable and a failed value until the bracket is narrower than `tolerance`.
 
-use crate::contact::force::ContactSolver;
-use crate::dynamics::{loads::Loads, relax_gravity, Correction, ExplicitSolver, State};
+use crate::contact::law::JointLaw;
 use crate::error::{Error, ModelError};
 use crate::mesh::Mesh;
-use crate::model::Model;
+use crate::problem::Problem;
 use crate::scene::Scene;
+use crate::simulation::Simulation;
 use serde::{Deserialize, Serialize};
 
 /// Settings of a strength-reduction search.
@@ -62,36 +63,40 @@ pub struct SsrResult {
     pub criterion: String,
 }
 
-/// Run one trial at factor `f`.
-pub fn ssr_trial(mesh: &Mesh, scene: &Scene, f: f64, opts: &SsrOptions) -> Result<SsrTrial, Error> {
-    let mut sc = scene.clone();
-    for j in &mut sc.joints {
-        let mu = match (j.mu, j.phi) {
-            (Some(m), _) => m,
-            (None, Some(p)) => p.to_radians().tan(),
-            (None, None) => 0.6,
-        };
-        j.mu = Some(mu / f);
-        j.phi = None;
-        j.cohesion = Some(j.cohesion.unwrap_or(0.0) / f);
-        // strength reduction is defined for perfectly plastic Mohr-Coulomb (as limit equilibrium):
-        // cohesion stays mobilised after local slip or opening
-        j.keep_cohesion = Some(true);
-    }
-    let model = Model::build(mesh.clone(), &sc)?;
-    let (loads, _) = Loads::build(&model, &sc)?;
-    if loads.gravity.is_none() {
+/// The problem of a strength-reduction search on `scene`: built once, with gravity.
+pub fn ssr_problem(mesh: &Mesh, scene: &Scene) -> Result<Problem, Error> {
+    let problem = Problem::build(scene.clone(), mesh.clone())?;
+    if problem.loads.gravity.is_none() {
         return Err(ModelError::Invalid("strength reduction needs gravity in the scene's loads".into()).into());
     }
-    let dt = sc.time.courant.unwrap_or(0.9) * model.stable_dt();
-    let mut solver = ExplicitSolver::new(&model, dt, sc.time.energy_tolerance);
-    let mut contact = ContactSolver::new(&model, &model.joints);
-    let mut state = State::at_rest(&model);
-    let eq = relax_gravity(&model, &loads, &mut solver, &mut state, Some(&mut contact as &mut dyn Correction), opts.residual, opts.max_steps)?;
+    Ok(problem)
+}
+
+/// The joints' laws of trial `f`: μ/F and c/F on the scene's laws, cohesion kept.
+fn reduced_laws(scene: &Scene, base: &[JointLaw], f: f64) -> Vec<JointLaw> {
+    scene
+        .joints
+        .iter()
+        .zip(base)
+        .map(|(j, law)| JointLaw { mu: j.friction().mu() / f, cohesion: j.cohesion.unwrap_or(0.0) / f, keep_cohesion: true, ..*law })
+        .collect()
+}
+
+/// Run one trial at factor `f` on `problem` (its joints' laws are set for the trial; `base` are
+/// the scene's laws).
+pub fn ssr_trial(problem: &mut Problem, base: &[JointLaw], f: f64, opts: &SsrOptions) -> Result<SsrTrial, Error> {
+    for (j, law) in problem.joints.iter_mut().zip(reduced_laws(&problem.scene, base, f)) {
+        law.validate().map_err(|e| ModelError::Invalid(format!("joint \"{}\": {e}", j.tag.name)))?;
+        j.law = law;
+    }
+    let problem = &*problem;
+    let mut sim = Simulation::new(problem)?;
+    let eq = sim.relax(opts.residual, opts.max_steps)?;
+    let state = &sim.state;
     let max_slip = state.contact.joints.iter().flat_map(|j| j.pairs.iter()).map(|p| p.slip).fold(0.0, f64::max);
     let monitor_displacement = match opts.monitor {
         Some(p) => {
-            let (n, _) = model.mesh.nearest_node(p).ok_or_else(|| ModelError::Invalid("empty mesh".into()))?;
+            let (n, _) = problem.model.mesh.nearest_node(p).ok_or_else(|| ModelError::Invalid("empty mesh".into()))?;
             (state.u[3 * n].powi(2) + state.u[3 * n + 1].powi(2) + state.u[3 * n + 2].powi(2)).sqrt()
         }
         None => 0.0,
@@ -104,13 +109,15 @@ pub fn ssr_trial(mesh: &Mesh, scene: &Scene, f: f64, opts: &SsrOptions) -> Resul
 pub fn strength_reduction(mesh: &Mesh, scene: &Scene, opts: &SsrOptions) -> Result<SsrResult, Error> {
     let mut trials = Vec::new();
     let [mut lo, mut hi] = opts.bracket;
-    let t_lo = ssr_trial(mesh, scene, lo, opts)?;
+    let mut problem = ssr_problem(mesh, scene)?;
+    let base: Vec<JointLaw> = problem.joints.iter().map(|j| j.law).collect();
+    let t_lo = ssr_trial(&mut problem, &base, lo, opts)?;
     let lo_failed = t_lo.failed;
     trials.push(t_lo);
     if lo_failed {
         return Err(ModelError::Invalid(format!("strength reduction: the model already fails at F = {lo} (lower the bracket)")).into());
     }
-    let t_hi = ssr_trial(mesh, scene, hi, opts)?;
+    let t_hi = ssr_trial(&mut problem, &base, hi, opts)?;
     let hi_failed = t_hi.failed;
     trials.push(t_hi);
     if !hi_failed {
@@ -118,7 +125,7 @@ pub fn strength_reduction(mesh: &Mesh, scene: &Scene, opts: &SsrOptions) -> Resu
     }
     while hi - lo > opts.tolerance {
         let mid = 0.5 * (lo + hi);
-        let t = ssr_trial(mesh, scene, mid, opts)?;
+        let t = ssr_trial(&mut problem, &base, mid, opts)?;
         if t.failed {
             hi = mid;
         } else {

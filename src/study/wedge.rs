@@ -449,7 +449,7 @@ pub fn variant_scene(base: &Scene, study: &WedgeStudy, run: &RunSpec) -> Result<
         m.e *= run.e_factor;
     }
     for j in &mut s.joints {
-        j.method = Some(run.method.clone());
+        j.method = Some(run.method.parse().map_err(crate::error::ModelError::Invalid)?);
         j.layer = Some(run.layer);
     }
     // The rock model: every volume that carries no weight (the rock) is fixed in the rigid

@@ -747,7 +747,7 @@ pub fn write_run_charts(study: &WedgeStudy, scene_path: &Path, run_dir: &Path) -
     let mut charts = Vec::new();
     let dir = run_dir.join("charts");
     let mut c = Chart::new(format!("Slip at P2 along the line of intersection — {}", scene.name()), "t [s]", "slip [m]");
-    c.series.push(Series::line(format!("FEM ({})", scene.joints.first().and_then(|j| j.method.clone()).unwrap_or_else(|| "nts".into()).to_uppercase()), thin(&slip, 2000)));
+    c.series.push(Series::line(format!("FEM ({})", scene.joints.first().map_or("nts", |j| j.method().as_str()).to_uppercase()), thin(&slip, 2000)));
     if dt.is_finite() {
         let a = sample_ground_motion(&motions, dt, scene.time.duration);
         for (bond, name) in [(Bond::Brittle, "rigid block, cohesion lost at first slide"), (Bond::Kept, "rigid block, cohesion kept")] {

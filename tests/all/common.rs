@@ -15,9 +15,11 @@ pub fn scratch(name: &str) -> PathBuf {
     d
 }
 
-use jointquake::dynamics::{loads::Loads, ExplicitSolver, Stage, State};
-use jointquake::model::Model;
+use jointquake::dynamics::State;
+use jointquake::mesh::Mesh;
+use jointquake::problem::Problem;
 use jointquake::scene::Scene;
+use jointquake::simulation::Simulation;
 
 /// A scene from inline JSON (fields as in pipelines/*.json).
 pub fn scene(v: serde_json::Value) -> Scene {
@@ -29,41 +31,34 @@ pub fn mean_u(u: &[f64], nodes: &[usize], c: usize) -> f64 {
     nodes.iter().map(|&n| u[3 * n + c]).sum::<f64>() / nodes.len() as f64
 }
 
-/// Run the dynamic stage from rest for `steps` steps at `courant` × the stable step, calling
-/// `observe(t, u)` after every step with u = u[n+1] at t[n+1].
-pub fn simulate(model: &Model, scene: &Scene, courant: f64, steps: usize, mut observe: impl FnMut(f64, &[f64])) -> (f64, State) {
-    let (loads, _) = Loads::build(model, scene).expect("loads");
-    let dt = courant * model.stable_dt();
-    let mut solver = ExplicitSolver::new(model, dt, scene.time.energy_tolerance);
-    let mut state = State::at_rest(model);
-    solver.start_energy(model, &mut state);
-    for _ in 0..steps {
-        solver.step(model, &loads, &mut state, Stage::Dynamic, None).expect("step");
-        observe(state.t, &state.u);
-    }
-    (dt, state)
+/// The problem of `scene` on `mesh` with the time step `courant` × the stable step (the scene's
+/// `time.dt` dropped).
+pub fn problem(mesh: Mesh, scene: &Scene, courant: f64) -> Problem {
+    let mut sc = scene.clone();
+    sc.time.dt = None;
+    sc.time.courant = Some(courant);
+    Problem::build(sc, mesh).expect("problem builds")
 }
 
-/// As [`simulate`], with the model's joints in contact (dynamic contact force) and optional
-/// gravity relaxation first. Returns (dt, final state).
-pub fn simulate_contact(model: &Model, scene: &Scene, courant: f64, steps: usize, relax: bool, mut observe: impl FnMut(f64, &State)) -> (f64, State) {
-    use jointquake::contact::force::ContactSolver;
-    use jointquake::dynamics::{relax_gravity, Correction};
-    let (loads, _) = Loads::build(model, scene).expect("loads");
-    let dt = courant * model.stable_dt();
-    let mut solver = ExplicitSolver::new(model, dt, scene.time.energy_tolerance);
-    let mut contact = ContactSolver::new(model, &model.joints);
-    let mut state = State::at_rest(model);
+/// Run the dynamic stage from rest for `steps` steps (the problem's time step), calling
+/// `observe(t, u)` after every step with u = u[n+1] at t[n+1]. Returns (dt, final state).
+pub fn simulate(problem: &Problem, steps: usize, mut observe: impl FnMut(f64, &[f64])) -> (f64, State) {
+    simulate_contact(problem, steps, false, |t, st| observe(t, &st.u))
+}
+
+/// As [`simulate`], with the problem's joints in contact (dynamic contact force) and optional
+/// gravity relaxation first (to a residual 1e-6, joints' own laws, no slip restart). Returns
+/// (dt, final state).
+pub fn simulate_contact(problem: &Problem, steps: usize, relax: bool, mut observe: impl FnMut(f64, &State)) -> (f64, State) {
+    let mut sim = Simulation::new(problem).expect("simulation");
     if relax {
-        let eq = relax_gravity(model, &loads, &mut solver, &mut state, Some(&mut contact as &mut dyn Correction), 1e-6, 200_000).expect("relaxation");
+        let eq = sim.relax(1e-6, 200_000).expect("relaxation");
         assert!(eq.converged, "gravity relaxation: {eq:?}");
-        state.step = 0;
-        state.t = 0.0;
+        sim.restart_clock();
     }
-    solver.start_energy(model, &mut state);
     for _ in 0..steps {
-        solver.step(model, &loads, &mut state, Stage::Dynamic, Some(&mut contact as &mut dyn Correction)).expect("step");
-        observe(state.t, &state);
+        sim.step().expect("step");
+        observe(sim.state.t, &sim.state);
     }
-    (dt, state)
+    (sim.dt(), sim.state)
 }

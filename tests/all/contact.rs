@@ -2,7 +2,7 @@
 //! earthquake against the rigid Newmark block. Fixture: tests/fixtures/incline_hex.msh
 //! (β = 30°, base 4 m along the slope in 8 elements, slider 1 × 0.5 × 0.5 m starting at
 //! s = 2.8…3.8 m; see tests/fixtures/README.md).
-use crate::common::{fixture, scratch, scene, simulate_contact};
+use crate::common::{fixture, problem, scratch, scene, simulate_contact};
 use jointquake::contact::query::{select_projection, INSIDE_TOL_DEFAULT};
 use jointquake::mesh::Mesh;
 use jointquake::model::Model;
@@ -45,10 +45,11 @@ fn slider_mean_downslope(model: &Model, u: &[f64]) -> f64 {
 fn block_on_incline_slides_as_analytic() {
     for method in ["nts", "ntn"] {
         let sc = incline_scene(json!({"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.3, "method": method}), 1e10, false);
-        let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc).unwrap();
+        let pb = problem(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc, 0.9);
+        let model = &pb.model;
         let dt = 0.9 * model.stable_dt();
         let steps = (1.0 / dt).round() as usize;
-        let (_, st) = simulate_contact(&model, &sc, 0.9, steps, false, |_, _| {});
+        let (_, st) = simulate_contact(&pb, steps, false, |_, _| {});
         let b = BETA.to_radians();
         let exact = 0.5 * G * (b.sin() - 0.3 * b.cos()) * st.t * st.t;
         let s = slider_mean_downslope(&model, &st.u);
@@ -63,10 +64,11 @@ fn block_on_incline_slides_as_analytic() {
 #[test]
 fn block_with_enough_friction_does_not_move() {
     let sc = incline_scene(json!({"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.6}), 1e10, true);
-    let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc).unwrap();
+    let pb = problem(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc, 0.9);
+    let model = &pb.model;
     let steps = (1.0 / (0.9 * model.stable_dt())) as usize;
     let mut worst: f64 = 0.0;
-    simulate_contact(&model, &sc, 0.9, steps, true, |_, st| {
+    simulate_contact(&pb, steps, true, |_, st| {
         for p in &st.contact.joints[0].pairs {
             worst = worst.max((p.d_t[0] * p.d_t[0] + p.d_t[1] * p.d_t[1]).sqrt());
         }
@@ -77,8 +79,8 @@ fn block_with_enough_friction_does_not_move() {
 
 /// Largest penetration (−gap) of any slave node into the *whole* master surface at the final
 /// positions (brute-force search): the true geometric error of the contact enforcement.
-fn true_penetration(model: &Model, u: &[f64]) -> f64 {
-    let j = &model.joints[0];
+fn true_penetration(pb: &jointquake::problem::Problem, u: &[f64]) -> f64 {
+    let (model, j) = (&pb.model, &pb.joints[0]);
     let pos = |n: usize| Vector3::new(model.mesh.nodes[n][0] + u[3 * n], model.mesh.nodes[n][1] + u[3 * n + 1], model.mesh.nodes[n][2] + u[3 * n + 2]);
     let faces: Vec<(usize, Vec<Vector3<f64>>)> =
         j.tag.master.faces.iter().enumerate().map(|(f, face)| (f, face.nodes().iter().map(|&n| pos(n as usize)).collect())).collect();
@@ -102,10 +104,11 @@ fn true_penetration(model: &Model, u: &[f64]) -> f64 {
 fn large_sliding_widen_keeps_every_pair_and_ntn_errs() {
     let run = |joint: serde_json::Value| {
         let sc = incline_scene(joint, 1e8, false);
-        let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc).unwrap();
+        let pb = problem(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc, 0.9);
+        let model = &pb.model;
         let steps = (1.5 / (0.9 * model.stable_dt())) as usize;
         let mut pen: f64 = 0.0;
-        let (_, st) = simulate_contact(&model, &sc, 0.9, steps, false, |_, st| {
+        let (_, st) = simulate_contact(&pb, steps, false, |_, st| {
             for p in &st.contact.joints[0].pairs {
                 if p.gap.is_finite() {
                     pen = pen.max(-p.gap);
@@ -113,7 +116,7 @@ fn large_sliding_widen_keeps_every_pair_and_ntn_errs() {
             }
         });
         let slide = slider_mean_downslope(&model, &st.u);
-        let err = true_penetration(&model, &st.u);
+        let err = true_penetration(&pb, &st.u);
         (st.contact.joints[0].events.clone(), pen, slide, err)
     };
     let (ev_r, _, slide_r, _) = run(json!({"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.3, "layer": 1, "on_exit": "report"}));
@@ -173,8 +176,8 @@ fn contact_results_are_bit_identical_across_runs_and_threads() {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let sc = incline_scene(json!({"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.3}), 1e9, false);
-            let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc).unwrap();
-            let (_, st) = simulate_contact(&model, &sc, 0.9, 2000, false, |_, _| {});
+            let pb = problem(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc, 0.9);
+            let (_, st) = simulate_contact(&pb, 2000, false, |_, _| {});
             let forces: Vec<f64> = st.contact.joints[0].pairs.iter().flat_map(|p| [p.r_n, p.r_t[0], p.r_t[1]]).collect();
             (st.u, forces)
         })
@@ -327,11 +330,12 @@ fn regression_bond_lost_to_a_round_off_gap_at_first_contact() {
     for method in ["nts", "penalty"] {
         let sc = incline_scene(json!({"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.3, "cohesion": 1e4,
                                       "method": method, "penalty_stiffness": 1e11}), 1e10, true);
-        let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc).unwrap();
-        let pen = jointquake::contact::force::ContactSolver::new(&model, &model.joints).penalty_omega2_bound(&model);
-        let courant = 0.9 * model.stable_dt_with(pen) / model.stable_dt();
-        let steps = (0.3 / (courant * model.stable_dt())).round() as usize;
-        let (_, st) = simulate_contact(&model, &sc, courant, steps, true, |_, _| {});
+        let pb = problem(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &sc, 0.9);
+        let model = &pb.model;
+        // the scene's default step: 0.9 of the stable step, the penalty springs' bound included
+        let dt = jointquake::simulation::Simulation::new(&pb).unwrap().dt();
+        let steps = (0.3 / dt).round() as usize;
+        let (_, st) = simulate_contact(&pb, steps, true, |_, _| {});
         let s = slider_mean_downslope(&model, &st.u);
         let intact = st.contact.joints[0].pairs.iter().filter(|p| p.hist.intact).count();
         eprintln!("{method}: down-slope displacement after {:.3} s: {s:.3e} m, {intact} of {} bonds intact", st.t, st.contact.joints[0].pairs.len());
@@ -349,9 +353,8 @@ fn regression_bond_lost_to_a_round_off_gap_at_first_contact() {
 /// sweeps (measured 1218 against 1473; on the contact benchmark 8.6 per step against 10.8).
 #[test]
 fn gauss_seidel_colour_order_reaches_the_fixed_point_of_the_slave_order() {
-    use jointquake::contact::force::ContactSolver;
-    use jointquake::dynamics::{loads::Loads, Correction, ExplicitSolver, Stage, State};
     use jointquake::mesh::structured::{add_box, BoxSpec};
+    use jointquake::simulation::Simulation;
     let mut mesh = Mesh { source: "<two boxes>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
     add_box(&mut mesh, &BoxSpec::new("lower", [1.0, 1.0, 0.2], [8, 8, 2]).at([0.0, 0.0, -0.2]));
     add_box(&mut mesh, &BoxSpec::new("upper", [1.0, 1.0, 0.2], [7, 7, 2]));
@@ -364,20 +367,17 @@ fn gauss_seidel_colour_order_reaches_the_fixed_point_of_the_slave_order() {
         "loads": {"traction": [{"group": "upper:z1", "traction": [1e5, 0.0, -1e6]}]},
         "time": {"duration": 1.0}
     }));
-    let model = Model::build(mesh, &sc).unwrap();
+    let mut sc = sc;
+    sc.time.energy_tolerance = 1.0;
+    let pb = problem(mesh, &sc, 0.9);
     let run = |colored: bool| {
-        let (loads, _) = Loads::build(&model, &sc).unwrap();
-        let mut solver = ExplicitSolver::new(&model, 0.9 * model.stable_dt(), 1.0);
-        let mut state = State::at_rest(&model);
-        solver.start_energy(&model, &mut state);
-        let mut cs = ContactSolver::new(&model, &model.joints);
-        cs.gs_colored = colored;
+        let mut sim = Simulation::new(&pb).unwrap();
+        sim.contact.as_mut().unwrap().gs_colored = colored;
         let mut sweeps = 0;
         for _ in 0..150 {
-            let info = solver.step(&model, &loads, &mut state, Stage::Dynamic, Some(&mut cs as &mut dyn Correction)).unwrap();
-            sweeps += info.correction.iterations;
+            sweeps += sim.step().unwrap().correction.iterations;
         }
-        (state, sweeps)
+        (sim.state, sweeps)
     };
     let (a, sweeps_colour) = run(true);
     let (b, sweeps_slave) = run(false);

@@ -4,22 +4,17 @@
 //! 2. Contact patch test on non-conforming flat joints (fixtures `boxes_*`).
 //! 3. Cohesion: onset of sliding of a block at c A + μ N.
 //!
-//! All runs drive the library directly (Model, Loads, ExplicitSolver, ContactSolver) so that the
-//! tests can set what scenes cannot (an initial velocity) and read the contact state per pair.
+//! All runs drive the run object (`Simulation`) step by step, so that the tests can set what
+//! scenes cannot (an initial velocity) and read the contact state per pair.
 //! Every test prints its measured numbers (`cargo test ... -- --nocapture`).
-use crate::common::{fixture, scene};
-use jointquake::contact::force::ContactSolver;
+use crate::common::{fixture, problem, scene};
 use jointquake::contact::law::PairState;
-use jointquake::dynamics::{loads::Loads, Correction, ExplicitSolver, Stage, State};
+use jointquake::dynamics::State;
+use jointquake::simulation::Simulation;
 use jointquake::mesh::structured::{add_box, box_mesh, BoxSpec};
 use jointquake::mesh::Mesh;
 use jointquake::model::Model;
 use serde_json::{json, Value};
-
-/// One explicit step of the dynamic stage with the contact correction.
-fn step(model: &Model, loads: &Loads, solver: &mut ExplicitSolver, state: &mut State, contact: &mut ContactSolver) {
-    solver.step(model, loads, state, Stage::Dynamic, Some(contact as &mut dyn Correction)).expect("step");
-}
 
 /// Discrete energy of central differences E = ½ v[n+½]ᵀ M v[n+½] + ½ u[n+1]ᵀ K u[n] (constant
 /// for a conservative run), from state.u = u[n+1], state.u_prev = u[n].
@@ -29,7 +24,7 @@ fn discrete_energy(model: &Model, state: &State, dt: f64) -> f64 {
     let mut e = 0.0;
     for i in 0..state.u.len() {
         let v = (state.u[i] - state.u_prev[i]) / dt;
-        e += 0.5 * model.mass[i / 3] * v * v + 0.5 * state.u[i] * ku[i];
+        e += 0.5 * model.mass.inertial[i / 3] * v * v + 0.5 * state.u[i] * ku[i];
     }
     e
 }
@@ -38,8 +33,8 @@ fn discrete_energy(model: &Model, state: &State, dt: f64) -> f64 {
 fn mean_velocity_x(model: &Model, state: &State, nodes: &[usize], dt: f64) -> f64 {
     let (mut p, mut m) = (0.0, 0.0);
     for &n in nodes {
-        p += model.mass[n] * (state.u[3 * n] - state.u_prev[3 * n]) / dt;
-        m += model.mass[n];
+        p += model.mass.inertial[n] * (state.u[3 * n] - state.u_prev[3 * n]) / dt;
+        m += model.mass.inertial[n];
     }
     p / m
 }
@@ -111,26 +106,26 @@ fn impact(method: &str, courant: f64, penalty: f64, energy_tolerance: f64) -> Im
     let mesh = two_bars();
     let bar1 = mesh.group_nodes("block:bar1").unwrap();
     let bar2 = mesh.group_nodes("block:bar2").unwrap();
-    let model = Model::build(mesh, &sc).unwrap();
-    let (loads, _) = Loads::build(&model, &sc).unwrap();
-    let mut contact = ContactSolver::new(&model, &model.joints);
+    let mut sc = sc;
+    sc.time.energy_tolerance = energy_tolerance;
+    let pb = problem(mesh, &sc, courant);
+    let model = &pb.model;
+    let mut sim = Simulation::new(&pb).unwrap();
     let dt_elements = model.stable_dt();
-    let dt_limit = model.stable_dt_with(contact.penalty_omega2_bound(&model));
-    let dt = courant * dt_limit;
+    let dt_limit = sim.time.dt_stable;
+    let dt = sim.dt();
     let c = (BAR_E / BAR_RHO).sqrt();
-    let mut solver = ExplicitSolver::new(&model, dt, energy_tolerance);
-    let mut state = State::at_rest(&model);
     // Initial velocity (the library has no initial-velocity option): central differences carry
     // the velocity as v[n−½] = (u[n] − u[n−1]) / dt, so u[−1] = u[0] − v0 dt on bar 1 gives
     // v[−½] = v0 on bar 1 and 0 on bar 2, exactly the start of refs/analytic.py section C
     // (no force acts before the contact). The energy account starts from ½ M v0².
     for &n in &bar1 {
-        state.u_prev[3 * n] = -BAR_V0 * dt;
+        sim.state.u_prev[3 * n] = -BAR_V0 * dt;
     }
-    solver.start_energy(&model, &mut state);
-    let e0: f64 = bar1.iter().map(|&n| 0.5 * model.mass[n] * BAR_V0 * BAR_V0).sum();
-    state.energy.initial = e0;
-    state.energy.scale = e0;
+    sim.solver.start_energy(model, &mut sim.state);
+    let e0: f64 = bar1.iter().map(|&n| 0.5 * model.mass.inertial[n] * BAR_V0 * BAR_V0).sum();
+    sim.state.energy.initial = e0;
+    sim.state.energy.scale = e0;
 
     let t_end = 3.0 * BAR_L / c;
     let steps = (t_end / dt).round() as usize;
@@ -138,9 +133,9 @@ fn impact(method: &str, courant: f64, penalty: f64, energy_tolerance: f64) -> Im
     let (mut first, mut last) = (f64::NAN, f64::NAN);
     let (mut sum, mut count, mut f_min, mut f_max) = (0.0, 0usize, f64::INFINITY, f64::NEG_INFINITY);
     for _ in 0..steps {
-        let t = state.t; // the force of the step from t[n] to t[n+1] is that of t[n]
-        step(&model, &loads, &mut solver, &mut state, &mut contact);
-        let f: f64 = state.contact.joints[0].pairs.iter().map(|p| p.r_n).sum();
+        let t = sim.state.t; // the force of the step from t[n] to t[n+1] is that of t[n]
+        sim.step().expect("step");
+        let f: f64 = sim.state.contact.joints[0].pairs.iter().map(|p| p.r_n).sum();
         if f > 1e-6 * f_exact {
             if first.is_nan() {
                 first = t;
@@ -163,10 +158,10 @@ fn impact(method: &str, courant: f64, penalty: f64, energy_tolerance: f64) -> Im
         f_min,
         f_max,
         duration: last - first + dt,
-        v1: mean_velocity_x(&model, &state, &bar1, dt),
-        v2: mean_velocity_x(&model, &state, &bar2, dt),
-        energy_ratio: discrete_energy(&model, &state, dt) / e0,
-        balance_error: state.energy.max_error,
+        v1: mean_velocity_x(model, &sim.state, &bar1, dt),
+        v2: mean_velocity_x(model, &sim.state, &bar2, dt),
+        energy_ratio: discrete_energy(model, &sim.state, dt) / e0,
+        balance_error: sim.state.energy.max_error,
     }
 }
 
@@ -302,31 +297,30 @@ fn patch(msh: &str, master: &str, slave: &str, method: &str) -> Patch {
         "time": {"duration": 1.0}
     }));
     let mesh = Mesh::from_msh(fixture(msh)).unwrap();
-    let model = Model::build(mesh, &sc).unwrap();
-    let (loads, _) = Loads::build(&model, &sc).unwrap();
-    let mut contact = ContactSolver::new(&model, &model.joints);
-    let dt = 0.9 * model.stable_dt();
-    let mut solver = ExplicitSolver::new(&model, dt, 0.05);
-    let mut state = State::at_rest(&model);
-    solver.start_energy(&model, &mut state);
+    let mut sc = sc;
+    sc.time.energy_tolerance = 0.05;
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let mut sim = Simulation::new(&pb).unwrap();
+    sim.solver.start_energy(model, &mut sim.state);
     let mut residual = f64::INFINITY;
     let mut steps = 0;
     while steps < 20_000 {
-        step(&model, &loads, &mut solver, &mut state, &mut contact);
+        sim.step().expect("step");
         steps += 1;
-        if state.t > ramp && steps % 50 == 0 {
-            let du = state.u.iter().zip(&state.u_prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-            let um = state.u.iter().map(|a| a.abs()).fold(0.0, f64::max);
+        if sim.state.t > ramp && steps % 50 == 0 {
+            let du = sim.state.u.iter().zip(&sim.state.u_prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let um = sim.state.u.iter().map(|a| a.abs()).fold(0.0, f64::max);
             residual = du / um;
             if residual < 1e-10 {
                 break;
             }
         }
     }
-    let j = &model.joints[0];
-    let mut out = Patch { pressure_interior: 0.0, pressure: 0.0, pressure_node: 0, pressure_at: [0.0; 3], szz_lower: 0.0, szz_upper: 0.0, total: 0.0, residual, steps, events: state.contact.joints[0].events.clone(), unloaded: Vec::new() };
+    let j = &pb.joints[0];
+    let mut out = Patch { pressure_interior: 0.0, pressure: 0.0, pressure_node: 0, pressure_at: [0.0; 3], szz_lower: 0.0, szz_upper: 0.0, total: 0.0, residual, steps, events: sim.state.contact.joints[0].events.clone(), unloaded: Vec::new() };
     let mut total = 0.0;
-    for (i, p) in state.contact.joints[0].pairs.iter().enumerate() {
+    for (i, p) in sim.state.contact.joints[0].pairs.iter().enumerate() {
         total += p.r_n;
         if p.r_n <= 0.0 {
             out.unloaded.push(model.mesh.node_tags[j.tag.slave_nodes()[i]]);
@@ -347,7 +341,7 @@ fn patch(msh: &str, master: &str, slave: &str, method: &str) -> Patch {
     out.total = total / (PATCH_P * area) - 1.0;
     // elements of the layer next to the joint: centroid within one element layer (0.25 m) of z = 0
     let mut stress = Vec::new();
-    model.element_stress_into(&state.u, &mut stress);
+    model.element_stress_into(&sim.state.u, &mut stress);
     let blocks = model.element_blocks();
     for (e, (_, nodes)) in model.element_cells().iter().enumerate() {
         let zc = nodes.iter().map(|&n| model.mesh.nodes[n as usize][2]).sum::<f64>() / nodes.len() as f64;
@@ -450,21 +444,20 @@ fn cohesion_onset(keep_cohesion: bool) -> (f64, f64, f64, f64) {
         "joints": [joint],
         "time": {"duration": 1.0}
     }));
-    let model = Model::build(mesh, &sc).unwrap();
-    let (loads, _) = Loads::build(&model, &sc).unwrap();
-    let mut contact = ContactSolver::new(&model, &model.joints);
-    let dt = 0.9 * model.stable_dt();
-    let mut solver = ExplicitSolver::new(&model, dt, 0.05);
-    let mut state = State::at_rest(&model);
-    solver.start_energy(&model, &mut state);
-    let j = &model.joints[0];
+    let mut sc = sc;
+    sc.time.energy_tolerance = 0.05;
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let mut sim = Simulation::new(&pb).unwrap();
+    sim.solver.start_energy(model, &mut sim.state);
+    let j = &pb.joints[0];
     let mut onset = f64::NAN;
     let mut normal = f64::NAN;
     let mut peak: f64 = 0.0;
-    while state.t < 0.75 * t_ramp {
-        let t = state.t;
-        step(&model, &loads, &mut solver, &mut state, &mut contact);
-        let pairs = &state.contact.joints[0].pairs;
+    while sim.state.t < 0.75 * t_ramp {
+        let t = sim.state.t;
+        sim.step().expect("step");
+        let pairs = &sim.state.contact.joints[0].pairs;
         // interface shear force on the master (lower) block = − force on the slave, x component
         let fx: f64 = -pairs.iter().enumerate().map(|(i, p)| p.r_t[0] * j.frames[i][1].x + p.r_t[1] * j.frames[i][2].x).sum::<f64>();
         peak = peak.max(fx.abs());

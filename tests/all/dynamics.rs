@@ -1,8 +1,6 @@
 //! Explicit elastodynamics against exact references (no contact).
-use crate::common::{mean_u, scene, simulate};
-use jointquake::dynamics::{loads::Loads, relax_gravity, ExplicitSolver, State};
+use crate::common::{mean_u, problem, scene, simulate};
 use jointquake::mesh::structured::{box_mesh, BoxSpec};
-use jointquake::model::Model;
 use serde_json::json;
 
 /// 1-D wave in a prism fixed at x = 0 with a step traction σ0 at x = L (ν = 0, so the
@@ -22,7 +20,8 @@ fn wave_in_prism_matches_dalembert() {
         "time": {"duration": 1.0}
     }));
     let end = mesh.group_nodes("prism:x1").unwrap();
-    let model = Model::build(mesh, &sc).unwrap();
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
     let c = (e / rho).sqrt();
     let v0 = s0 / (rho * c);
     let t_end = 4.0 * l / c;
@@ -30,7 +29,7 @@ fn wave_in_prism_matches_dalembert() {
     let steps = (t_end / dt) as usize;
     let peak = 2.0 * s0 * l / e;
     let mut worst: f64 = 0.0;
-    simulate(&model, &sc, 0.9, steps, |t, u| {
+    simulate(&pb, steps, |t, u| {
         let exact = if t < 2.0 * l / c { v0 * t } else { v0 * (4.0 * l / c - t) };
         worst = worst.max((mean_u(u, &end, 0) - exact).abs());
     });
@@ -66,11 +65,12 @@ fn cantilever_frequency(nx: usize, nz: usize, tets: bool) -> f64 {
         "time": {"duration": 1.0}
     }));
     let tip = mesh.group_nodes("beam:x1").unwrap();
-    let model = Model::build(mesh, &sc).unwrap();
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
     let dt = 0.9 * model.stable_dt();
     let steps = (0.6 / dt) as usize; // about 3 periods of the first mode
     let (mut ts, mut us) = (Vec::new(), Vec::new());
-    simulate(&model, &sc, 0.9, steps, |t, u| {
+    simulate(&pb, steps, |t, u| {
         ts.push(t);
         us.push(mean_u(u, &tip, 2));
     });
@@ -119,11 +119,11 @@ fn gravity_column_stress_after_equilibrium() {
         "loads": {"gravity": {"g": g}},
         "time": {"duration": 0.0}
     }));
-    let model = Model::build(mesh, &sc).unwrap();
-    let (loads, _) = Loads::build(&model, &sc).unwrap();
-    let mut solver = ExplicitSolver::new(&model, 0.9 * model.stable_dt(), 0.05);
-    let mut state = State::at_rest(&model);
-    let eq = relax_gravity(&model, &loads, &mut solver, &mut state, None, 1e-7, 200_000).unwrap();
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
+    let eq = sim.relax(1e-7, 200_000).unwrap();
+    let state = &sim.state;
     assert!(eq.converged, "relaxation: {eq:?}");
     let mut stress = Vec::new();
     model.element_stress_into(&state.u, &mut stress);
@@ -152,8 +152,7 @@ fn results_identical_on_one_and_two_threads() {
                 "loads": {"traction": [{"group": "b:x1", "traction": [1e5, 2e5, -3e5]}]},
                 "time": {"duration": 1.0}
             }));
-            let model = Model::build(mesh, &sc).unwrap();
-            simulate(&model, &sc, 0.9, 200, |_, _| {}).1.u
+            simulate(&problem(mesh, &sc, 0.9), 200, |_, _| {}).1.u
         })
     };
     let a = run(1);

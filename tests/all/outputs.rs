@@ -237,9 +237,9 @@ fn instability_stops_the_run_naming_step_place_and_cause() {
     let model = Model::build(Mesh::from_msh(fixture("column_hex.msh")).unwrap(), &sc).unwrap();
     let (loads, _) = Loads::build(&model, &sc).unwrap();
     let mut solver = ExplicitSolver::new(&model, 1.2 * model.stable_dt(), 0.05);
-    let mut state = State::at_rest(&model);
+    let mut state = State::at_rest(&model, Default::default());
     solver.start_energy(&model, &mut state);
-    let err = (0..100_000).find_map(|_| solver.step(&model, &loads, &mut state, Stage::Dynamic, None).err()).expect("the unstable run must stop");
+    let err = (0..100_000).find_map(|_| solver.step(&model, &loads, &mut state, Stage::Dynamic, &mut []).err()).expect("the unstable run must stop");
     let msg = err.to_string();
     eprintln!("{msg}");
     match &err {
@@ -268,12 +268,12 @@ fn non_finite_value_stops_the_run_naming_the_node() {
     let (node, _) = model.mesh.nearest_node([1.0, 1.0, 10.0]).unwrap();
     let loads = Loads { patterns: vec![ForcePattern { forces: vec![(node, [f64::NAN, 0.0, 0.0])], ramp: 0.0 }], ..Default::default() };
     let mut solver = ExplicitSolver::new(&model, 0.9 * model.stable_dt(), 0.05);
-    let mut state = State::at_rest(&model);
+    let mut state = State::at_rest(&model, Default::default());
     solver.start_energy(&model, &mut state);
     for _ in 0..5 {
-        solver.step(&model, &Loads::default(), &mut state, Stage::Dynamic, None).unwrap();
+        solver.step(&model, &Loads::default(), &mut state, Stage::Dynamic, &mut []).unwrap();
     }
-    let err = solver.step(&model, &loads, &mut state, Stage::Dynamic, None).unwrap_err();
+    let err = solver.step(&model, &loads, &mut state, Stage::Dynamic, &mut []).unwrap_err();
     let msg = err.to_string();
     eprintln!("{msg}");
     let tag = model.mesh.node_tags[node];
@@ -341,8 +341,8 @@ fn joint_outputs_series_history_and_summary() {
     }
     assert!(j["max_sweeps"].as_u64().unwrap() >= 1);
     // documented: 1e-12 × the joint size (diagonal of the bounding box of both surfaces)
-    let model = Model::build(Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &jointquake::scene::Scene::load(&p).unwrap()).unwrap();
-    let tol = 1e-12 * model.joints[0].tag.size;
+    let joints = jointquake::contact::joint::build_joints(&Mesh::from_msh(fixture("incline_hex.msh")).unwrap(), &jointquake::scene::Scene::load(&p).unwrap()).unwrap();
+    let tol = 1e-12 * joints[0].tag.size;
     assert!((j["gs_tolerance"].as_f64().unwrap() - tol).abs() < 1e-15 * tol, "{} vs {tol}", j["gs_tolerance"]);
     let csv_max_slip = rows.iter().map(|r| r[2]).fold(0.0, f64::max);
     assert!((j["max_slip"].as_f64().unwrap() - csv_max_slip).abs() <= 1e-9 * csv_max_slip, "{} vs {csv_max_slip}", j["max_slip"]);

@@ -1,0 +1,133 @@
+//! The summary of a run (`summary.json`): written at the end of every run, read back by the
+//! studies through [`RunSummary::read`] (typed, next to its writer).
+
+use super::history::Monitor;
+use super::joints::JointPeaks;
+use crate::dynamics::{Energy, EquilibriumInfo};
+use crate::error::OutputError;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Peak of a quantity and where it happened.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Peak {
+    pub value: f64,
+    pub t: f64,
+    pub node_tag: u64,
+}
+
+/// What a run reports (written as `summary.json`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunSummary {
+    pub scene: String,
+    pub mesh: PathBuf,
+    pub nodes: usize,
+    pub elements: usize,
+    pub tets: usize,
+    pub hexes: usize,
+    pub hex_shapes: usize,
+    pub dt: f64,
+    pub dt_stable: f64,
+    pub critical_element: u64,
+    pub critical_group: String,
+    pub steps: usize,
+    pub duration: f64,
+    pub threads: usize,
+    pub equilibrium: Option<EquilibriumInfo>,
+    pub energy: Energy,
+    pub peak_displacement: Peak,
+    /// Peak |v| [m/s] and |a| [m/s²] of any node (relative to the base, central differences;
+    /// sampled every 10 steps, as the peak displacement).
+    pub peak_velocity: Peak,
+    pub peak_acceleration: Peak,
+    pub monitors: Vec<Monitor>,
+    pub frames: usize,
+    pub out_dir: PathBuf,
+    pub pvd: Option<PathBuf>,
+    pub histories: Vec<PathBuf>,
+    /// Joint-surface series (one `.pvd` per joint).
+    pub joint_series: Vec<PathBuf>,
+    /// Joint maxima and search/Gauss–Seidel diagnostics.
+    pub joints: Vec<JointPeaks>,
+    pub notes: Vec<String>,
+    /// Stage wall times [s].
+    pub timings: Vec<(String, f64)>,
+    pub wall_time: f64,
+}
+
+impl RunSummary {
+    /// Write `summary.json` into `out_dir` (whole, pretty-printed).
+    pub fn write(&self, out_dir: &Path) -> Result<PathBuf, OutputError> {
+        let sp = out_dir.join("summary.json");
+        std::fs::write(&sp, serde_json::to_string_pretty(self).expect("summary serialises")).map_err(|e| OutputError::write(&sp, e))?;
+        Ok(sp)
+    }
+
+    /// Read a `summary.json` written by [`Self::write`] (`path` is the file or its run directory).
+    pub fn read(path: &Path) -> Result<RunSummary, OutputError> {
+        let file = if path.is_dir() { path.join("summary.json") } else { path.to_path_buf() };
+        let text = std::fs::read_to_string(&file).map_err(|e| OutputError::read(&file, e))?;
+        serde_json::from_str(&text).map_err(|e| OutputError::read(&file, format!("not a run summary: {e}")))
+    }
+
+    /// One screen of text for the end of a run.
+    pub fn to_text(&self) -> String {
+        let mut s = String::new();
+        use std::fmt::Write as _;
+        let _ = writeln!(s, "scene {}: {} nodes, {} elements ({} tet4, {} hex8 in {} shapes)", self.scene, self.nodes, self.elements, self.tets, self.hexes, self.hex_shapes);
+        let _ = writeln!(s, "  mesh            {}", self.mesh.display());
+        let _ = writeln!(
+            s,
+            "  time step       dt = {:.4e} s ({:.0}% of the stable {:.4e} s; critical element {} in \"{}\")",
+            self.dt,
+            100.0 * self.dt / self.dt_stable,
+            self.dt_stable,
+            self.critical_element,
+            self.critical_group
+        );
+        let _ = writeln!(s, "  steps           {} over {} s on {} thread{}", self.steps, self.duration, self.threads, if self.threads == 1 { "" } else { "s" });
+        if let Some(eq) = &self.equilibrium {
+            let _ = writeln!(s, "  gravity         equilibrium in {} steps, residual {:.2e}{}", eq.steps, eq.residual, if eq.converged { "" } else { " (NOT converged)" });
+        }
+        let _ = writeln!(s, "  energy          max balance error {:.2e} of the energy scale {:.3e} J", self.energy.max_error, self.energy.scale);
+        let _ = writeln!(s, "  peak |u|        {:.4e} m at t = {:.4} s, node {}", self.peak_displacement.value, self.peak_displacement.t, self.peak_displacement.node_tag);
+        let _ = writeln!(s, "  peak |v|, |a|   {:.4e} m/s (t = {:.4} s, node {}), {:.4e} m/s² (t = {:.4} s, node {})", self.peak_velocity.value, self.peak_velocity.t, self.peak_velocity.node_tag, self.peak_acceleration.value, self.peak_acceleration.t, self.peak_acceleration.node_tag);
+        for m in &self.monitors {
+            let _ = writeln!(s, "  monitor {:8} node {} ({:.3e} m from the requested point)", m.name, m.node_tag, m.snap_distance);
+        }
+        for j in &self.joints {
+            let _ = writeln!(
+                s,
+                "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {} (tolerance {:.1e} m){}",
+                j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps, j.gs_tolerance,
+                if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
+            );
+            let e = &j.events;
+            if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures + e.recentred + e.perimeter_kept > 0 {
+                let _ = writeln!(
+                    s,
+                    "                 search: {} re-centrings, {} kept at the perimeter, {} Layer2 widenings, {} fresh searches, {} node-steps lost, {} projection failures",
+                    e.recentred, e.perimeter_kept, e.widened_layer2, e.fresh_searches, e.lost, e.projection_failures
+                );
+            }
+        }
+        for n in &self.notes {
+            let _ = writeln!(s, "  note            {n}");
+        }
+        let t: Vec<String> = self.timings.iter().map(|(k, v)| format!("{k} {v:.2} s")).collect();
+        let _ = writeln!(s, "  wall time       {:.2} s ({})", self.wall_time, t.join(", "));
+        let _ = writeln!(s, "results in {}", self.out_dir.display());
+        if let Some(p) = &self.pvd {
+            let _ = writeln!(s, "  ParaView series {} ({} frames)", p.display(), self.frames);
+        }
+        for p in &self.joint_series {
+            let _ = writeln!(s, "  joint series    {}", p.display());
+        }
+        for h in &self.histories {
+            let _ = writeln!(s, "  history         {}", h.display());
+        }
+        let _ = writeln!(s, "  summary         {}", self.out_dir.join("summary.json").display());
+        s
+    }
+}
+

@@ -1,0 +1,75 @@
+//! A problem: everything a run needs that does not change while it runs.
+//!
+//! `Scene + Mesh → Problem { scene, model, joints, loads }`, built once: the [`Model`] (elements,
+//! masses, supports), the joints as their own stage ([`build_joints`]: tagged once from the
+//! mesh; a strength-reduction trial changes only their laws), and the [`Loads`]. A
+//! `simulation::Simulation` borrows it.
+//!
+//! Where the dam's stages go: the reservoir's added mass is added to `model` here
+//! (`Model::add_inertia`), the massless foundation becomes one more constraint of the run.
+
+use crate::contact::joint::{build_joints, ContactJoint};
+use crate::dynamics::loads::Loads;
+use crate::error::{Error, ModelError};
+use crate::mesh::Mesh;
+use crate::model::Model;
+use crate::scene::Scene;
+
+/// The immutable input of a run.
+#[derive(Debug)]
+pub struct Problem {
+    pub scene: Scene,
+    pub model: Model,
+    /// The joints in scene order (empty: no contact).
+    pub joints: Vec<ContactJoint>,
+    pub loads: Loads,
+    /// Notes of the build (records read and scaled, snapped loads).
+    pub notes: Vec<String>,
+}
+
+impl Problem {
+    /// Build the model, the joints and the loads of `scene` on `mesh`.
+    pub fn build(scene: Scene, mesh: Mesh) -> Result<Problem, Error> {
+        let mut model = Model::build(mesh, &scene)?;
+        let mut notes = Vec::new();
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.added_mass) {
+            notes.push(add_reservoir_mass(&mut model, &scene, r)?);
+        }
+        let mut p = Problem::from_model(scene, model)?;
+        p.notes.extend(notes);
+        Ok(p)
+    }
+
+    /// The joints and loads of `scene` on a built model.
+    pub fn from_model(scene: Scene, model: Model) -> Result<Problem, Error> {
+        let joints = build_joints(&model.mesh, &scene)?;
+        let (loads, notes) = Loads::build(&model, &scene)?;
+        Ok(Problem { scene, model, joints, loads, notes })
+    }
+}
+
+/// Add the reservoir's Westergaard/Kuo added mass m_a n nᵀ (`crate::reservoir`) to the inertia
+/// of the wet nodes (no weight); a note with the total.
+pub fn add_reservoir_mass(model: &mut Model, scene: &Scene, r: &crate::scene::ReservoirScene) -> Result<String, Error> {
+    let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
+    let mut faces = Vec::new();
+    for g in &r.faces {
+        faces.extend(crate::reservoir::wet_faces(&model.mesh, g, &volume)?);
+    }
+    let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
+    let added = crate::reservoir::added_masses(&model.mesh, &faces, &spec);
+    let mut total = 0.0;
+    for a in &added {
+        if model.mass.inertial[a.node] == 0.0 {
+            return Err(ModelError::Invalid(format!(
+                "reservoir: wet node {} has no structural mass (is the wet face on a massless block?): the added mass goes on the dam's face",
+                model.mesh.node_tags[a.node]
+            ))
+            .into());
+        }
+        let n = nalgebra::Vector3::from(a.normal);
+        model.add_inertia(a.node, n * n.transpose() * a.mass);
+        total += a.mass;
+    }
+    Ok(format!("reservoir: added mass {:.4e} kg on {} wet nodes (depth {:.3} m, Westergaard/Kuo)", total, added.len(), spec.depth()))
+}

@@ -1,0 +1,198 @@
+//! One run in memory: `Simulation::new(&problem)?` → `.equilibrate()?` → `.run(&mut recorder)?`.
+//!
+//! The same object serves the CLI (`pipeline::run`), strength reduction (`study::ssr`), the
+//! tests and the benchmarks, so the rule for dt ([`TimeStep::resolve`]), the gravity
+//! equilibrium and the reset after it exist once.
+//!
+//! Owns: the run's [`State`] (what changes), the solvers' scratch ([`ExplicitSolver`], the
+//! contact correction), the resolved [`TimeStep`]. Borrows the [`Problem`] (immutable).
+//! Outputs go through an [`Observer`] (`output::recorder::Recorder` writes frames, histories,
+//! peaks and the summary; a test can observe with a closure, [`FnObserver`]).
+//!
+//! Sequence and invariants:
+//! - `new`: dt resolved (scene `time.dt` checked against the stable step, penalty bound
+//!   included), state at rest at t = 0, energy account started.
+//! - `equilibrate`: the scene's `equilibrium` (relaxation of gravity with the joints' bonds kept
+//!   or not, residual checked against `max_residual`), then the clock restarts at t = 0 and
+//!   the joints' slip counters restart (slip while settling is not seismic slip).
+//! - `run`: `duration / dt` dynamic steps; after each, the observer sees u[n−1], u[n], u[n+1]
+//!   and reports at t[n] ([`Simulation::kinematics`]).
+
+use crate::constraint::Constraint;
+use crate::contact::force::ContactSolver;
+use crate::contact::ContactState;
+use crate::dynamics::time::TimeStep;
+use crate::dynamics::{relax_gravity, EquilibriumInfo, ExplicitSolver, Kinematics, Stage, State, StepInfo};
+use crate::error::{Error, ModelError, StepError};
+use crate::problem::Problem;
+
+/// What watches a run: called once before the first dynamic step, after every step and at the
+/// end.
+pub trait Observer {
+    /// Before the first dynamic step (the state is the equilibrium, at t = 0).
+    fn start(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
+        Ok(())
+    }
+    /// After dynamic step `k` (0-based) of `n_steps`.
+    fn observe(&mut self, sim: &Simulation<'_>, k: usize, n_steps: usize) -> Result<(), Error>;
+    /// After the last step.
+    fn finish(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
+        Ok(())
+    }
+}
+
+/// An observer from a closure called after every step with the simulation.
+pub struct FnObserver<F>(pub F);
+
+impl<F: FnMut(&Simulation<'_>)> Observer for FnObserver<F> {
+    fn observe(&mut self, sim: &Simulation<'_>, _k: usize, _n: usize) -> Result<(), Error> {
+        (self.0)(sim);
+        Ok(())
+    }
+}
+
+/// A run of a [`Problem`].
+pub struct Simulation<'p> {
+    pub problem: &'p Problem,
+    pub time: TimeStep,
+    pub solver: ExplicitSolver,
+    /// The contact correction (`None` without joints).
+    pub contact: Option<ContactSolver<'p>>,
+    /// The static condensation of the massless blocks (`None` without them); runs after the
+    /// contact correction.
+    pub foundation: Option<crate::foundation::Condensation>,
+    pub state: State,
+    /// The outcome of [`Self::equilibrate`] (`None` before it, or without gravity relaxation).
+    pub equilibrium: Option<EquilibriumInfo>,
+    /// Notes for the summary (the problem's, then the run's).
+    pub notes: Vec<String>,
+}
+
+impl<'p> Simulation<'p> {
+    /// A run at rest at t = 0 with the scene's time step.
+    pub fn new(problem: &'p Problem) -> Result<Simulation<'p>, Error> {
+        let model = &problem.model;
+        let contact = (!problem.joints.is_empty()).then(|| ContactSolver::new(model, &problem.joints));
+        let penalty = contact.as_ref().map(|c| c.penalty_omega2_bound(model)).unwrap_or(0.0);
+        let t0 = std::time::Instant::now();
+        let foundation = crate::foundation::Condensation::build(model, faer::Par::Seq).map_err(|e| ModelError::Invalid(e.to_string()))?;
+        let mut notes = problem.notes.clone();
+        // the condensed foundation stiffens the interface: its ω² bound adds to the elements'
+        let found_w2 = foundation.as_ref().map(|f| f.omega2_bound()).unwrap_or(0.0);
+        if let Some(f) = foundation.as_ref() {
+            let i = f.info(t0.elapsed().as_secs_f64());
+            notes.push(format!(
+                "massless blocks: {} unknowns condensed on {} interface unknowns (factor {} entries, {:.2} s); foundation ω² bound {:.4e} 1/s² in the stable step",
+                i.condensed_unknowns, i.interface_unknowns, i.factor_entries, i.setup_time, i.omega2_bound
+            ));
+        }
+        let time = TimeStep::resolve(model, &problem.scene.time, penalty + found_w2)?;
+        notes.extend(time.note());
+        let mut solver = ExplicitSolver::new(model, time.dt, problem.scene.time.energy_tolerance);
+        let mut state = State::at_rest(model, ContactState::new(&problem.joints));
+        solver.start_energy(model, &mut state);
+        Ok(Simulation { problem, time, solver, contact, foundation, state, equilibrium: None, notes })
+    }
+
+    /// The step [s].
+    pub fn dt(&self) -> f64 {
+        self.time.dt
+    }
+
+    /// Dynamic steps of the scene's `time.duration`.
+    pub fn n_steps(&self) -> usize {
+        self.time.steps_for(self.problem.scene.time.duration)
+    }
+
+    /// Gravity equilibrium as the scene's `equilibrium` says (nothing without gravity or with
+    /// `method: "none"`), then the clock and the joints' slip counters restart. An equilibrium
+    /// not reached within `max_residual` is an error; one above `tolerance` only a note.
+    pub fn equilibrate(&mut self) -> Result<Option<&EquilibriumInfo>, Error> {
+        let sc = &self.problem.scene;
+        if (self.problem.loads.gravity.is_none() && self.problem.loads.static_forces.is_empty()) || sc.equilibrium.method != "relaxation" {
+            return Ok(None);
+        }
+        if let Some(c) = self.contact.as_mut() {
+            c.keep_bonds = sc.equilibrium.joint_bonds == "kept";
+        }
+        let eq = self.relax(sc.equilibrium.tolerance, sc.equilibrium.max_steps)?;
+        if !eq.converged && eq.residual > sc.equilibrium.max_residual {
+            return Err(ModelError::Invalid(format!(
+                "gravity equilibrium not reached in {} steps: residual {:.2e} > max_residual {:.1e}. Raise equilibrium.max_steps or check supports (a block without supports or contact falls freely).",
+                eq.steps, eq.residual, sc.equilibrium.max_residual
+            ))
+            .into());
+        }
+        if !eq.converged {
+            self.notes.push(format!("gravity equilibrium residual {:.2e} above tolerance {:.1e} (accepted below max_residual)", eq.residual, sc.equilibrium.tolerance));
+        }
+        if let Some(c) = self.contact.as_mut() {
+            c.keep_bonds = false;
+        }
+        self.restart_clock();
+        self.state.contact.restart_slip();
+        self.equilibrium = Some(eq);
+        Ok(self.equilibrium.as_ref())
+    }
+
+    /// Dynamic relaxation of gravity alone ([`relax_gravity`]) with the joints in contact, to a
+    /// relative residual `tol` within `max_steps` steps; no check, no restart (strength
+    /// reduction reads the state as it ends).
+    pub fn relax(&mut self, tol: f64, max_steps: usize) -> Result<EquilibriumInfo, StepError> {
+        let p = self.problem;
+        let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(2);
+        if let Some(c) = self.contact.as_mut() {
+            cs.push(c);
+        }
+        if let Some(f) = self.foundation.as_mut() {
+            cs.push(f);
+        }
+        relax_gravity(&p.model, &p.loads, &mut self.solver, &mut self.state, &mut cs, tol, max_steps)
+    }
+
+    /// Restart the clock at t = 0 from the current state (taken as at rest) and the energy
+    /// account from it.
+    pub fn restart_clock(&mut self) {
+        self.state.step = 0;
+        self.state.t = 0.0;
+        self.solver.start_energy(&self.problem.model, &mut self.state);
+    }
+
+    /// One dynamic step (gravity, base motion, loads, Rayleigh damping, contact).
+    pub fn step(&mut self) -> Result<StepInfo, StepError> {
+        let p = self.problem;
+        match (self.contact.as_mut(), self.foundation.as_mut()) {
+            (Some(c), None) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut [c as &mut dyn Constraint<ContactState>]),
+            (None, None) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut []),
+            (Some(c), Some(f)) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut [c as &mut dyn Constraint<ContactState>, f]),
+            (None, Some(f)) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut [f as &mut dyn Constraint<ContactState>]),
+        }
+    }
+
+    /// u[n−1], u[n], u[n+1] after a step, at t[n] = t − dt (outputs report there, where
+    /// central differences give the velocity and acceleration).
+    pub fn kinematics(&self) -> Kinematics<'_> {
+        Kinematics { t: self.state.t - self.time.dt, dt: self.time.dt, u_prev: &self.solver.u_nm1, u: &self.state.u_prev, u_next: &self.state.u }
+    }
+
+    /// The state as it is, as kinematics at rest at its own time (before any step, or for a
+    /// run of no steps).
+    pub fn kinematics_at_rest(&self) -> Kinematics<'_> {
+        Kinematics { t: self.state.t, dt: self.time.dt, u_prev: &self.state.u, u: &self.state.u, u_next: &self.state.u }
+    }
+
+    /// `n` dynamic steps with `observer` watching.
+    pub fn run_steps(&mut self, n: usize, observer: &mut dyn Observer) -> Result<(), Error> {
+        observer.start(self)?;
+        for k in 0..n {
+            self.step()?;
+            observer.observe(self, k, n)?;
+        }
+        observer.finish(self)
+    }
+
+    /// The scene's duration ([`Self::n_steps`] dynamic steps) with `observer` watching.
+    pub fn run(&mut self, observer: &mut dyn Observer) -> Result<(), Error> {
+        self.run_steps(self.n_steps(), observer)
+    }
+}
