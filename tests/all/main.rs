@@ -7,6 +7,7 @@ mod cli;
 mod common;
 mod contact;
 mod contact_validation;
+mod dam_physics;
 mod dynamics;
 mod mesh;
 mod outputs;
