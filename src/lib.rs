@@ -32,6 +32,7 @@ pub mod gmsh;
 pub mod interface;
 pub mod linalg;
 pub mod mesh;
+pub mod modes;
 pub mod model;
 pub mod output;
 pub mod pipeline;

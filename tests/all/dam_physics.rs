@@ -219,3 +219,38 @@ fn base_shear_of_a_stiff_block_with_a_wet_face_includes_the_westergaard_mass() {
     println!("wet base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), dry {dry:.5e} N", 100.0 * (v / expect - 1.0));
     assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs (M + 7/12 ρ H² b) a = {expect}");
 }
+
+#[test]
+fn modes_command_on_the_cantilever_fixture() {
+    // Reference: Euler–Bernoulli cantilever L = 10, b = h = 1 m (E = 1 GPa, ν = 0, ρ = 2000):
+    // ω1 = 1.875104² √(E I / (ρ A L⁴)) = 7.177 rad/s in both bending planes (square section),
+    // first-mode effective mass 0.6131 of the total (Chopra, Dynamics of Structures, cantilever
+    // mode 1). hex8 20 × 1 × 2 (tests/fixtures/cantilever_hex.msh): f within 3 %, the effective
+    // mass fraction within 3 % (of the mass the ground moves: the clamped nodes excluded).
+    let dir = scratch("dam_modes_cli");
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": crate::common::fixture("cantilever_hex.msh")},
+        "materials": [{"group": "block:beam", "E": 1e9, "nu": 0.0, "rho": 2000.0}],
+        "boundary": [{"group": "bc:fixed"}],
+        "time": {"duration": 0.0}
+    }));
+    let mesh = Mesh::from_msh(crate::common::fixture("cantilever_hex.msh")).unwrap();
+    let pb = problem(mesh, &sc, 0.9);
+    let r = jointquake::modes::modes(&pb, 4, &dir).unwrap();
+    let text = r.to_text();
+    println!("{text}");
+    let w1 = 1.875104f64.powi(2) * (1e9f64 / 12.0 / (2000.0 * 1e4)).sqrt();
+    let f1 = w1 / (2.0 * std::f64::consts::PI);
+    for m in &r.modes[..2] {
+        assert!((m.frequency_hz / f1 - 1.0).abs() < 0.03, "f = {} Hz vs Euler–Bernoulli {f1} Hz", m.frequency_hz);
+        assert!(m.residual < 1e-8);
+    }
+    // the two bending modes together carry 61.3 % of the mass along y and along z
+    for c in [1, 2] {
+        let frac: f64 = r.modes[..2].iter().map(|m| m.effective_fraction[c]).sum();
+        assert!((frac / 0.6131 - 1.0).abs() < 0.03, "direction {c}: effective fraction {frac}");
+    }
+    assert!(r.pvd.exists() && dir.join("modes/mode_004.vtu").exists() && dir.join("modes/modes.json").exists());
+    let pvd = std::fs::read_to_string(&r.pvd).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 4);
+}
