@@ -105,6 +105,7 @@ bench: build
 	cargo bench --bench explicit
 	cargo bench --bench tagger
 	cargo bench --bench contact
+	cargo bench --bench foundation
 
 fixtures: venv
 	GMSH=$(GMSH) scripts/fixtures.sh
