@@ -254,3 +254,58 @@ fn modes_command_on_the_cantilever_fixture() {
     let pvd = std::fs::read_to_string(&r.pvd).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 4);
 }
+
+fn dam_on_rock_with_a_tied_joint(rho_rock: f64) -> (Mesh, jointquake::scene::Scene) {
+    // a 2 × 2 × 1 m dam block (hex 3 × 3 × 2) on a 4 × 4 × 3 m massless rock (hex 4 × 4 × 3):
+    // non-conforming, bonded by a tied NTS joint (master the rock's top, slave the dam's base)
+    let mut mesh = box_mesh(&BoxSpec::new("rock", [4.0, 4.0, 3.0], [4, 4, 3]));
+    jointquake::mesh::structured::add_box(&mut mesh, &BoxSpec::new("dam", [2.0, 2.0, 1.0], [3, 3, 2]).at([1.0, 1.0, 3.0]));
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [
+            {"group": "block:rock", "E": 2e10, "nu": 0.25, "rho": rho_rock, "massless": true},
+            {"group": "block:dam", "E": 2.5e10, "nu": 0.2, "rho": 2400.0}
+        ],
+        "boundary": [{"group": "rock:z0"}],
+        "loads": {"gravity": {}},
+        "joints": [{"name": "base", "master": "rock:z1", "slave": "dam:z0", "tied": true}],
+        "time": {"duration": 0.0}
+    }));
+    (mesh, sc)
+}
+
+#[test]
+fn tied_joint_on_a_massless_block_gets_a_weightless_massive_layer() {
+    // The decision of docs/dam_physics.md: the rock elements touching the joint keep their
+    // density (so the dynamic contact force has nodal masses on the master side) but no weight;
+    // the rest of the rock is condensed. Check: the layer nodes have mass and no weight, the
+    // condensed unknowns exist, and after gravity relaxation (residual 1e-6) the vertical
+    // reaction at the fixed rock base equals the dam's weight alone (ρ g V = 2400 · 9.81 · 4 N)
+    // to 1e-4: no weight from the rock or its layer, the load carried through the tied joint
+    // and the condensed rock.
+    let (mesh, sc) = dam_on_rock_with_a_tied_joint(2700.0);
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let top = model.mesh.group_nodes("rock:z1").unwrap();
+    assert!(top.iter().all(|&n| model.mass.inertial[n] > 0.0 && model.mass.gravitational[n] == 0.0), "layer: mass, no weight");
+    assert!(model.condensed.iter().any(|&c| c != 0));
+    let mut sim = Simulation::new(&pb).unwrap();
+    assert!(sim.foundation.is_some());
+    let eq = sim.relax(1e-6, 200_000).unwrap();
+    assert!(eq.converged, "{eq:?}");
+    let mut ku = vec![0.0; 3 * model.n_nodes()];
+    model.internal_forces_into(&sim.state.u, &mut ku);
+    let base = model.mesh.group_nodes("rock:z0").unwrap();
+    let rz: f64 = base.iter().map(|&n| ku[3 * n + 2]).sum();
+    let weight = 2400.0 * 9.81 * 4.0;
+    println!("dam on massless rock, tied: base reaction {rz:.6e} N, dam weight {weight:.6e} N");
+    assert!((rz.abs() / weight - 1.0).abs() < 1e-4, "reaction {rz} vs weight {weight}");
+}
+
+#[test]
+fn joint_on_a_massless_block_without_density_is_a_clear_error() {
+    // rho = 0 leaves the joint's layer without mass: refused, naming the group and the fix
+    let (mesh, sc) = dam_on_rock_with_a_tied_joint(0.0);
+    let err = jointquake::problem::Problem::build(sc, mesh).unwrap_err().to_string();
+    assert!(err.contains("block:rock") && err.contains("joint") && err.contains("rho"), "{err}");
+}
