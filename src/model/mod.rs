@@ -103,7 +103,7 @@ pub struct Model {
     pub mass_damped: Vec<bool>,
     pub beta: f64,
     pub critical: CriticalElement,
-    /// Per material: a massless block (stiffness only; `crate::foundation` condenses it).
+    /// Per material: a massless block (stiffness only; the foundation module condenses it).
     pub massless: Vec<bool>,
     /// Per node: the components condensed statically (nodes of massless blocks without mass,
     /// components not fixed by the boundary conditions); such nodes are also in `fixed` (7), so
@@ -558,7 +558,7 @@ impl Model {
     /// by the largest element ω_max with lumped mass).
     fn max_element_eigenvalue(&self) -> CriticalElement {
         // an element of a massless block sets no stable step (its nodes are condensed, or carry
-        // the mass of other elements: the foundation's bound on them is `crate::foundation`'s);
+        // the mass of other elements: the foundation's bound on them is the foundation module's);
         // its layer elements along a joint have their mass and count as usual
         let pure_massless = |cell: u32| self.massless_cells[cell as usize];
         let t = (0..self.tets.nodes.len())
