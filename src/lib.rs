@@ -5,10 +5,15 @@
 //! ParaView series, CSV histories and charts.
 //!
 //! ```text
-//! geo/*.geo --gmsh--> .msh --mesh--> Mesh --interface (tagger)--> joints: slave normals, Layer1/Layer2, NTN
-//!     --model--> Model (elements, lumped mass, BCs; built once, immutable)
-//!     --dynamics--> State (u, u_prev, contact history) stepped by ExplicitSolver (scratch only)
-//!     --output--> out/<scene>/ frames/*.vtu, <scene>.pvd, histories/*.csv, summary.json --report--> charts
+//! geo/*.geo --gmsh--> .msh --mesh--> Mesh --Problem::build--> Problem {
+//!     model   (elements, NodalMass: inertia vs weight, supports; built once, immutable)
+//!     joints  (their own stage: tagged once by interface/, laws, frames)
+//!     loads   (gravity, base records, tractions) }
+//!   --Simulation::new(&problem)--> .equilibrate() --> .run(&mut recorder)
+//!       State (t, u[n], u[n−1], energy, contact history) stepped by ExplicitSolver (scratch
+//!       only); after each prediction the step calls its constraints (constraint.rs: contact)
+//!   --Recorder (output/)--> out/<scene>/ frames/*.vtu, <scene>.pvd, joints/, histories/*.csv,
+//!       summary.json (RunSummary, read back by RunSummary::read) --report--> charts
 //! ```
 //!
 //! Units: SI throughout (m, kg, s, Pa, N); records are read in g and converted to m/s² once,
@@ -16,12 +21,18 @@
 //!
 //! Where each convention lives:
 //! - node order of cells, outward face order: [`mesh::cell`]
-//! - scene fields, units and defaults: [`scene`] (and `docs/scenes.md`)
-//! - time integration, damping, stable step: [`dynamics`]
+//! - scene fields, units and defaults, and the rules checked once (friction μ or φ, time-step
+//!   knobs, contact method enums): [`scene`] (and `docs/scenes.md`)
+//! - time integration, damping: [`dynamics`]; the one time-step rule: [`dynamics::time`]
+//! - masses (inertial vs gravitational, 3×3 inertia blocks, massless nodes): [`model::mass`]
+//! - contact conventions (normal, gap sign, frame, forces): [`contact`]; the contact mobility of
+//!   an anisotropic mass: `docs/contact.md`
 //! - errors (what the user must fix): [`error`]
 //! - charts (PNG + SVG) and Markdown tables for study reports: [`report`]
 //!
-//! [`pipeline::run`] is the recipe: the only function that sequences the stages.
+//! [`pipeline::run`] is the recipe: the only function that sequences the stages, through the
+//! run object [`simulation::Simulation`], which strength reduction, the tests and the benchmarks
+//! drive too. Module dependencies point down (no import loop): `docs/architecture.md`.
 
 pub mod constraint;
 pub mod contact;

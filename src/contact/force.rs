@@ -753,6 +753,22 @@ impl ContactSolver<'_> {
         // penalty forces of step n act like external forces on the prediction
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             add_pair_force_into(u_next, &self.inv_mass, dt2, s, &masters[..nm as usize], &weights, &rvec);
+            if !self.block_nodes.is_empty() {
+                // a penalty force is an external force: at a block node its displacement is
+                // dt² M⁻¹ R with the full inverse, not the scalar of `inv_mass`
+                let r = |k: usize| if k == 0 { rvec } else { -rvec * weights[k - 1] };
+                for (k, &nd) in std::iter::once(&(s as u32)).chain(&masters[..nm as usize]).enumerate() {
+                    if self.block_nodes.binary_search(&nd).is_ok() {
+                        let b = model.mass.block_of(nd as usize).expect("a block node");
+                        let i0 = 3 * nd as usize;
+                        let exact = b.inverse * r(k) * dt2;
+                        let scalar = r(k) * (dt2 * self.inv_mass[nd as usize]);
+                        for c in 0..3 {
+                            u_next[i0 + c] += exact[c] - scalar[c];
+                        }
+                    }
+                }
+            }
         }
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             let s = s as usize;

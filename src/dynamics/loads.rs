@@ -161,20 +161,28 @@ impl Loads {
         let g = if with_gravity { self.gravity.unwrap_or([0.0; 3]) } else { [0.0; 3] };
         let ag = if with_dynamic { self.ground_acceleration(t) } else { [0.0; 3] };
         let mass = &model.mass;
-        for (n, (&m, &mg)) in mass.inertial.iter().zip(&mass.gravitational).enumerate() {
-            let w = match &self.gravity_nodes {
-                Some(mask) if !mask[n] => 0.0,
-                _ => 1.0,
-            };
-            if m == mg {
-                f[3 * n] = m * (w * g[0] - ag[0]);
-                f[3 * n + 1] = m * (w * g[1] - ag[1]);
-                f[3 * n + 2] = m * (w * g[2] - ag[2]);
-            } else {
-                // weight and inertia apart: m_g g − m a_g
-                f[3 * n] = mg * w * g[0] - m * ag[0];
-                f[3 * n + 1] = mg * w * g[1] - m * ag[1];
-                f[3 * n + 2] = mg * w * g[2] - m * ag[2];
+        let weight = |n: usize| match &self.gravity_nodes {
+            Some(mask) if !mask[n] => 0.0,
+            _ => 1.0,
+        };
+        match &mass.gravitational {
+            // weight = inertia: one vector, m (w g − a_g)
+            None => {
+                for (n, &m) in mass.inertial.iter().enumerate() {
+                    let w = weight(n);
+                    f[3 * n] = m * (w * g[0] - ag[0]);
+                    f[3 * n + 1] = m * (w * g[1] - ag[1]);
+                    f[3 * n + 2] = m * (w * g[2] - ag[2]);
+                }
+            }
+            // weight and inertia apart: m_g w g − m a_g
+            Some(gm) => {
+                for (n, (&m, &mg)) in mass.inertial.iter().zip(gm).enumerate() {
+                    let w = weight(n);
+                    for c in 0..3 {
+                        f[3 * n + c] = mg * w * g[c] - m * ag[c];
+                    }
+                }
             }
         }
         if with_dynamic && ag != [0.0; 3] {

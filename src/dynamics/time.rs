@@ -43,7 +43,8 @@ impl TimeStep {
                 }
                 dt
             }
-            None => time.courant.unwrap_or(DEFAULT_COURANT) * dt_stable,
+            None if dt_stable.is_finite() => time.courant.unwrap_or(DEFAULT_COURANT) * dt_stable,
+            None => return Err(ModelError::Invalid("no element has mass, so none sets a stable step: give `time.dt` [s]".into())),
         };
         Ok(TimeStep { dt, dt_stable, dt_elements, penalty_omega2 })
     }

@@ -11,7 +11,8 @@
 //!
 //! Everything is one pass over the slave nodes with reused buffers (no per-node allocation).
 
-use super::normals::{add, dot, scale, sub};
+use super::normals::vec3;
+use nalgebra::Vector3;
 use super::{Csr, Surface};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
@@ -32,8 +33,7 @@ pub fn nearest_master_nodes_into(master: &Surface, points: &[[f64; 3]], tie: f64
         let nn = tree.query(p).nearest_one::<SquaredEuclidean<f64>>().execute();
         let mut best = nn.item;
         let dist = |l: u32| {
-            let x = master.points[l as usize];
-            dot(sub(*p, x), sub(*p, x)).sqrt()
+            (vec3(*p) - vec3(master.points[l as usize])).norm()
         };
         let mut dbest = dist(best);
         if tie > 0.0 {
@@ -96,11 +96,11 @@ pub fn layer2_candidates(master: &Surface, layer1: &Csr) -> Csr {
 /// bounding sphere (centre = node average, radius = farthest node) is already ≥ the best distance.
 pub fn master_surface_distances_into(master: &Surface, points: &[[f64; 3]], layer2: &Csr, out: &mut [f64]) {
     assert_eq!(points.len(), out.len());
-    let spheres: Vec<([f64; 3], f64)> = (0..master.faces.len())
+    let spheres: Vec<(Vector3<f64>, f64)> = (0..master.faces.len())
         .map(|f| {
             let (x, n) = master.face_points(f);
-            let c = scale(x[..n].iter().fold([0.0; 3], |s, &q| add(s, q)), 1.0 / n as f64);
-            let r = x[..n].iter().map(|&q| dot(sub(q, c), sub(q, c)).sqrt()).fold(0.0, f64::max);
+            let c = x[..n].iter().fold(Vector3::zeros(), |s: Vector3<f64>, &q| s + vec3(q)) * (1.0 / n as f64);
+            let r = x[..n].iter().map(|&q| (vec3(q) - c).norm()).fold(0.0, f64::max);
             (c, r * (1.0 + 1e-12))
         })
         .collect();
@@ -108,7 +108,7 @@ pub fn master_surface_distances_into(master: &Surface, points: &[[f64; 3]], laye
         let mut best = f64::INFINITY;
         for &f in layer2.row(i) {
             let (c, r) = spheres[f as usize];
-            if dot(sub(*p, c), sub(*p, c)).sqrt() - r >= best {
+            if (vec3(*p) - c).norm() - r >= best {
                 continue;
             }
             let (x, n) = master.face_points(f as usize);
@@ -124,46 +124,47 @@ pub fn master_surface_distances_into(master: &Surface, points: &[[f64; 3]], laye
 /// Distance [m] from point `p` to the triangle (a, b, c) (closest point by Voronoi regions,
 /// Ericson, Real-Time Collision Detection §5.1.5).
 pub fn point_triangle_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    let dist = |q: [f64; 3]| dot(sub(p, q), sub(p, q)).sqrt();
+    let (p, a, b, c) = (vec3(p), vec3(a), vec3(b), vec3(c));
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(&ap);
+    let d2 = ac.dot(&ap);
+    let dist = |q: Vector3<f64>| (p - q).norm();
     if d1 <= 0.0 && d2 <= 0.0 {
         return dist(a);
     }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
+    let bp = p - b;
+    let d3 = ab.dot(&bp);
+    let d4 = ac.dot(&bp);
     if d3 >= 0.0 && d4 <= d3 {
         return dist(b);
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
         let v = d1 / (d1 - d3);
-        return dist(add(a, scale(ab, v)));
+        return dist(a + ab * v);
     }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
+    let cp = p - c;
+    let d5 = ab.dot(&cp);
+    let d6 = ac.dot(&cp);
     if d6 >= 0.0 && d5 <= d6 {
         return dist(c);
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
         let w = d2 / (d2 - d6);
-        return dist(add(a, scale(ac, w)));
+        return dist(a + ac * w);
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
         let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return dist(add(b, scale(sub(c, b), w)));
+        return dist(b + (c - b) * w);
     }
     let denom = 1.0 / (va + vb + vc);
     let v = vb * denom;
     let w = vc * denom;
-    dist(add(a, add(scale(ab, v), scale(ac, w))))
+    dist(a + (ab * v + ac * w))
 }
 
 #[cfg(test)]

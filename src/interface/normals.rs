@@ -13,46 +13,29 @@
 use super::{Surface, invalid};
 use crate::error::InterfaceError;
 use crate::mesh::CellKind;
+use nalgebra::Vector3;
 
+/// A point or vector of the mesh's `[f64; 3]` storage as a nalgebra vector.
 #[inline]
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-#[inline]
-pub(crate) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-#[inline]
-pub(crate) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-#[inline]
-pub(crate) fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
+pub(crate) fn vec3(a: [f64; 3]) -> Vector3<f64> {
+    Vector3::from(a)
 }
 
 /// Unnormalised outward normal of a face with nodes `x` (outward order; 3 or 4 points used).
 #[inline]
-pub(crate) fn face_normal_raw(kind: CellKind, x: &[[f64; 3]]) -> [f64; 3] {
+pub(crate) fn face_normal_raw(kind: CellKind, x: &[[f64; 3]]) -> Vector3<f64> {
+    let p = |i: usize| vec3(x[i]);
     match kind {
-        CellKind::Quad4 => cross(sub(x[2], x[0]), sub(x[3], x[1])),
-        _ => cross(sub(x[1], x[0]), sub(x[2], x[0])),
+        CellKind::Quad4 => (p(2) - p(0)).cross(&(p(3) - p(1))),
+        _ => (p(1) - p(0)).cross(&(p(2) - p(0))),
     }
 }
 
 /// Outward unit normal of a face (quad4: at its centre). Zero vector for a degenerate face.
 pub fn face_unit_normal(kind: CellKind, x: &[[f64; 3]]) -> [f64; 3] {
     let n = face_normal_raw(kind, x);
-    let l = norm(n);
-    if l > 0.0 { scale(n, 1.0 / l) } else { [0.0; 3] }
+    let l = n.norm();
+    if l > 0.0 { (n * (1.0 / l)).into() } else { [0.0; 3] }
 }
 
 /// 2×2 Gauss points (±1/√3, weights 1).
@@ -65,13 +48,13 @@ const QREF: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
 pub(crate) fn quad_tributary(x: &[[f64; 3]], out: &mut [f64; 4]) {
     *out = [0.0; 4];
     for [xi, eta] in GAUSS2 {
-        let mut dxi = [0.0; 3];
-        let mut deta = [0.0; 3];
+        let mut dxi = Vector3::zeros();
+        let mut deta = Vector3::zeros();
         for (i, r) in QREF.iter().enumerate() {
-            dxi = add(dxi, scale(x[i], 0.25 * r[0] * (1.0 + eta * r[1])));
-            deta = add(deta, scale(x[i], 0.25 * r[1] * (1.0 + xi * r[0])));
+            dxi += vec3(x[i]) * (0.25 * r[0] * (1.0 + eta * r[1]));
+            deta += vec3(x[i]) * (0.25 * r[1] * (1.0 + xi * r[0]));
         }
-        let det = norm(cross(dxi, deta));
+        let det = dxi.cross(&deta).norm();
         for (i, r) in QREF.iter().enumerate() {
             out[i] += 0.25 * (1.0 + xi * r[0]) * (1.0 + eta * r[1]) * det;
         }
@@ -86,7 +69,7 @@ pub fn face_area(kind: CellKind, x: &[[f64; 3]]) -> f64 {
             quad_tributary(x, &mut t);
             t.iter().sum()
         }
-        _ => 0.5 * norm(face_normal_raw(kind, x)),
+        _ => 0.5 * face_normal_raw(kind, x).norm(),
     }
 }
 
@@ -96,15 +79,15 @@ pub fn face_area(kind: CellKind, x: &[[f64; 3]]) -> f64 {
 /// which happens only on a folded surface.
 pub fn slave_normals_into(joint: &str, surface: &Surface, out: &mut [[f64; 3]]) -> Result<(), InterfaceError> {
     assert_eq!(out.len(), surface.nodes.len());
-    let face_normals: Vec<[f64; 3]> = (0..surface.faces.len())
+    let face_normals: Vec<Vector3<f64>> = (0..surface.faces.len())
         .map(|f| {
             let (x, n) = surface.face_points(f);
-            face_unit_normal(surface.faces[f].kind, &x[..n])
+            vec3(face_unit_normal(surface.faces[f].kind, &x[..n]))
         })
         .collect();
     for (l, o) in out.iter_mut().enumerate() {
-        let s = surface.faces_of_node(l).iter().fold([0.0; 3], |s, &f| add(s, face_normals[f as usize]));
-        let len = norm(s);
+        let s = surface.faces_of_node(l).iter().fold(Vector3::zeros(), |s, &f| s + face_normals[f as usize]);
+        let len = s.norm();
         if !(len > 1e-12) {
             let p = surface.points[l];
             return Err(invalid(
@@ -116,7 +99,7 @@ pub fn slave_normals_into(joint: &str, surface: &Surface, out: &mut [[f64; 3]]) 
                 ),
             ));
         }
-        *o = scale(s, 1.0 / len);
+        *o = (s * (1.0 / len)).into();
     }
     Ok(())
 }
@@ -153,13 +136,13 @@ mod tests {
         let mut r = [0.0; 4];
         for &(xi, wx) in &g3 {
             for &(eta, we) in &g3 {
-                let mut dxi = [0.0; 3];
-                let mut deta = [0.0; 3];
+                let mut dxi = Vector3::zeros();
+                let mut deta = Vector3::zeros();
                 for (i, q) in QREF.iter().enumerate() {
-                    dxi = add(dxi, scale(x[i], 0.25 * q[0] * (1.0 + eta * q[1])));
-                    deta = add(deta, scale(x[i], 0.25 * q[1] * (1.0 + xi * q[0])));
+                    dxi += vec3(x[i]) * (0.25 * q[0] * (1.0 + eta * q[1]));
+                    deta += vec3(x[i]) * (0.25 * q[1] * (1.0 + xi * q[0]));
                 }
-                let det = norm(cross(dxi, deta));
+                let det = dxi.cross(&deta).norm();
                 for (i, q) in QREF.iter().enumerate() {
                     r[i] += wx * we * 0.25 * (1.0 + xi * q[0]) * (1.0 + eta * q[1]) * det;
                 }
@@ -181,14 +164,13 @@ mod tests {
     fn quad_normal_is_centre_normal() {
         let x = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.1], [1.0, 1.0, 0.0], [0.0, 1.0, 0.1]];
         let n = face_unit_normal(CellKind::Quad4, &x);
-        let mut dxi = [0.0; 3];
-        let mut deta = [0.0; 3];
+        let mut dxi = Vector3::zeros();
+        let mut deta = Vector3::zeros();
         for (i, q) in QREF.iter().enumerate() {
-            dxi = add(dxi, scale(x[i], 0.25 * q[0]));
-            deta = add(deta, scale(x[i], 0.25 * q[1]));
+            dxi += vec3(x[i]) * (0.25 * q[0]);
+            deta += vec3(x[i]) * (0.25 * q[1]);
         }
-        let c = cross(dxi, deta);
-        let c = scale(c, 1.0 / norm(c));
-        assert!(norm(sub(n, c)) < 1e-15);
+        let c = dxi.cross(&deta).normalize();
+        assert!((vec3(n) - c).norm() < 1e-15);
     }
 }

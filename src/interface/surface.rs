@@ -5,7 +5,8 @@
 //! face of every volume (`topology::volume_faces`, one allocation per face), only volume faces whose
 //! nodes all lie on the group are looked up: this keeps 10⁶-face surfaces in the sub-second range.
 
-use super::normals::{add, dot, face_area, face_normal_raw, scale, sub};
+use super::normals::{face_area, face_normal_raw, vec3};
+use nalgebra::Vector3;
 use super::{Csr, invalid};
 use crate::error::InterfaceError;
 use crate::mesh::topology::face_key;
@@ -269,13 +270,10 @@ impl Surface {
             }
             area += a;
             let vol = &mesh.cells[f.volume_cell];
-            let centre_vol = scale(
-                vol.nodes().iter().fold([0.0; 3], |s, &n| add(s, mesh.nodes[n as usize])),
-                1.0 / vol.nodes().len() as f64,
-            );
-            let centre_face = scale(x.iter().fold([0.0; 3], |s, &p| add(s, p)), 1.0 / x.len() as f64);
+            let centre_vol = vol.nodes().iter().fold(Vector3::zeros(), |s: Vector3<f64>, &n| s + vec3(mesh.nodes[n as usize])) * (1.0 / vol.nodes().len() as f64);
+            let centre_face = x.iter().fold(Vector3::zeros(), |s: Vector3<f64>, &p| s + vec3(p)) * (1.0 / x.len() as f64);
             let n = face_normal_raw(f.kind, &x);
-            if dot(sub(centre_vol, centre_face), n) >= 0.0 {
+            if (centre_vol - centre_face).dot(&n) >= 0.0 {
                 return Err(invalid(
                     joint,
                     format!(

@@ -6,8 +6,10 @@
 //!   is declared ([`NodalMass::add_inertia`]; e.g. a reservoir's added mass m_a n nᵀ along a wet
 //!   face's normal). A node with `m = 0` and no block has no inertia (a massless foundation
 //!   node): the explicit step does not integrate it, a constraint (static condensation) must.
-//! - **Gravitational mass**: what gravity acts on (the weight is m_g g). Equal to the lumped
-//!   mass by default; added inertia adds none (water's added mass has no weight on the dam).
+//! - **Gravitational mass**: what gravity acts on (the weight is m_g g). The lumped mass by
+//!   default (`gravitational: None`, so that the load loop reads one vector, as before); added
+//!   inertia adds none (water's added mass has no weight on the dam). A model whose weight is
+//!   not its lumped inertia sets its own vector ([`NodalMass::set_gravitational`]).
 //!
 //! Hot path: the step divides by `inertial[node]` for every node, as it did with one mass per
 //! node, and then redoes the few block nodes with their inverse ([`InertiaBlock::inverse`]);
@@ -33,8 +35,8 @@ pub struct InertiaBlock {
 pub struct NodalMass {
     /// Lumped (isotropic) inertial mass per node [kg]: m in m I (+ A for block nodes).
     pub inertial: Vec<f64>,
-    /// Gravitational mass per node [kg].
-    pub gravitational: Vec<f64>,
+    /// Gravitational mass per node [kg]; `None`: equal to `inertial` (the default).
+    pub gravitational: Option<Vec<f64>>,
     /// The nodes with an added inertia, ascending by node (empty for most models).
     pub blocks: Vec<InertiaBlock>,
 }
@@ -42,7 +44,30 @@ pub struct NodalMass {
 impl NodalMass {
     /// Isotropic masses, weight equal to inertia (the lumped mass of the elements).
     pub fn lumped(m: Vec<f64>) -> NodalMass {
-        NodalMass { gravitational: m.clone(), inertial: m, blocks: Vec::new() }
+        NodalMass { gravitational: None, inertial: m, blocks: Vec::new() }
+    }
+
+    /// Gravitational mass of `node` [kg].
+    #[inline]
+    pub fn weight_mass(&self, node: usize) -> f64 {
+        match &self.gravitational {
+            Some(g) => g[node],
+            None => self.inertial[node],
+        }
+    }
+
+    /// Set the gravitational mass of every node [kg] (one per node).
+    pub fn set_gravitational(&mut self, g: Vec<f64>) {
+        assert_eq!(g.len(), self.inertial.len(), "one gravitational mass per node");
+        self.gravitational = Some(g);
+    }
+
+    /// Total gravitational mass [kg].
+    pub fn total_weight_mass(&self) -> f64 {
+        match &self.gravitational {
+            Some(g) => g.iter().sum(),
+            None => self.inertial.iter().sum(),
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -147,7 +172,7 @@ mod tests {
         assert_eq!(mass.inverse_along(0, &n), 0.5);
         assert!((mass.apply(1, &n) - n * 8.0).norm() < 1e-14);
         assert!((mass.total_along(&n) - 10.0).abs() < 1e-14);
-        assert_eq!(mass.gravitational, vec![2.0, 3.0]);
+        assert_eq!((mass.weight_mass(0), mass.weight_mass(1)), (2.0, 3.0));
     }
 
     /// A fixed component takes no part in the inverse: with z fixed, the x–y block alone.

@@ -32,6 +32,24 @@ impl Lame {
         self.d_matrix().cholesky().expect("D is positive definite for 0 ≤ ν < 0.5").l()
     }
 
+    /// Hooke's law, the one place it is written: the stress σ = λ tr(ε) I + 2μ ε (Voigt: xx, yy,
+    /// zz, xy, yz, zx) [Pa] of the small strain ε = sym(H) of a displacement gradient
+    /// `h[i][j] = ∂u_i/∂x_j`.
+    #[inline(always)]
+    pub fn stress_of_gradient(&self, h: &[[f64; 3]; 3]) -> [f64; 6] {
+        let tr = h[0][0] + h[1][1] + h[2][2];
+        let l = self.lambda * tr;
+        let mu = self.mu;
+        [
+            l + 2.0 * mu * h[0][0],
+            l + 2.0 * mu * h[1][1],
+            l + 2.0 * mu * h[2][2],
+            mu * (h[0][1] + h[1][0]),
+            mu * (h[1][2] + h[2][1]),
+            mu * (h[2][0] + h[0][2]),
+        ]
+    }
+
     /// P-wave modulus λ + 2μ [Pa].
     pub fn p_modulus(&self) -> f64 {
         self.lambda + 2.0 * self.mu

@@ -497,11 +497,11 @@ impl Model {
             tets,
             hexes,
             mass: {
+                // the layer of a massless block along a joint: inertia, no weight
+                let weight: Option<Vec<f64>> = weightless.iter().any(|&w| w).then(|| mass.iter().zip(&weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect());
                 let mut m = NodalMass::lumped(mass);
-                for (g, &w) in m.gravitational.iter_mut().zip(&weightless) {
-                    if w {
-                        *g = 0.0;
-                    }
+                if let Some(g) = weight {
+                    m.set_gravitational(g);
                 }
                 m
             },
@@ -606,8 +606,12 @@ impl Model {
 
     /// Stable time step [s] of the central-difference scheme with Rayleigh damping:
     /// the largest dt with ω²dt² + 2(α + βω²) dt − 4 ≤ 0 at ω = ω_max (undamped: 2/ω_max).
+    /// Infinite when no element has mass (nothing to integrate explicitly).
     pub fn stable_dt(&self) -> f64 {
         let w2 = self.critical.omega2;
+        if w2 <= 0.0 {
+            return f64::INFINITY;
+        }
         let c = self.alpha + self.beta * w2;
         (-c + (c * c + 4.0 * w2).sqrt()) / w2
     }
@@ -616,6 +620,9 @@ impl Model {
     /// (λ_max(A + B) ≤ λ_max(A) + λ_max(B)), e.g. for penalty springs.
     pub fn stable_dt_with(&self, extra_omega2: f64) -> f64 {
         let w2 = self.critical.omega2 + extra_omega2;
+        if w2 <= 0.0 {
+            return f64::INFINITY;
+        }
         let c = self.alpha + self.beta * w2;
         (-c + (c * c + 4.0 * w2).sqrt()) / w2
     }

@@ -53,17 +53,7 @@ pub fn stress(g: &[f64; 9], u: &[[f64; 3]; 4], m: &Lame) -> [f64; 6] {
             }
         }
     }
-    let tr = h[0][0] + h[1][1] + h[2][2];
-    let l = m.lambda * tr;
-    let mu = m.mu;
-    [
-        l + 2.0 * mu * h[0][0],
-        l + 2.0 * mu * h[1][1],
-        l + 2.0 * mu * h[2][2],
-        mu * (h[0][1] + h[1][0]),
-        mu * (h[1][2] + h[2][1]),
-        mu * (h[2][0] + h[0][2]),
-    ]
+    m.stress_of_gradient(&h)
 }
 
 /// Internal nodal forces f_a = V σ ∇N_a for nodal displacements u.

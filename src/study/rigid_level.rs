@@ -83,20 +83,15 @@ pub fn rigid_wedge_slip(input: &WedgeInput, a: &[[f64; 3]], dt: f64, bond: Bond,
 
 
 /// The limit-equilibrium wedge of a FEM scene: `base` (geometry: planes, H) with the friction and
-/// cohesion of the scene's joints `joint_a` and `joint_b` (μ or φ, c; the joints' defaults: μ 0.6,
-/// c 0), the density of the scene's `wedge_group` material and the scene's g, so that the rigid
+/// cohesion of the scene's joints `joint_a` and `joint_b` (μ or φ by the scene's one friction rule,
+/// `JointSceneSpec::friction`; c 0 by default), the density of the scene's `wedge_group` material and the scene's g, so that the rigid
 /// level always carries the strength the FEM joints carry. A joint or material the scene does
 /// not have keeps `base`'s value.
 pub fn wedge_input_from_scene(base: &WedgeInput, scene: &Scene, joint_a: &str, joint_b: &str, wedge_group: &str) -> WedgeInput {
     let mut w = base.clone();
     let strength = |name: &str, old: crate::rigid::wedge::JointStrength| {
         scene.joints.iter().find(|j| j.name == name).map_or(old, |j| {
-            let phi = match (j.mu, j.phi) {
-                (Some(mu), _) => mu.atan().to_degrees(),
-                (None, Some(p)) => p,
-                (None, None) => 0.6f64.atan().to_degrees(),
-            };
-            crate::rigid::wedge::JointStrength { cohesion: j.cohesion.unwrap_or(0.0), friction: phi }
+            crate::rigid::wedge::JointStrength { cohesion: j.cohesion.unwrap_or(0.0), friction: j.friction().phi_deg() }
         })
     };
     w.joint_a = strength(joint_a, w.joint_a);
