@@ -298,13 +298,7 @@ impl Model {
         // material of every mesh cell (u32::MAX: none)
         let mut owner = vec![u32::MAX; mesh.cells.len()];
         for (mi, ms) in scene.materials.iter().enumerate() {
-            if ms.rho == 0.0 && !ms.massless {
-                return Err(ModelError::Invalid(format!(
-                    "material \"{}\": rho = 0: declare a block without mass `\"massless\": true` (a massless foundation), else give its density",
-                    ms.group
-                ))
-                .into());
-            }
+            // rho = 0 without `massless`: nodes without inertia, held (the scene loader refuses it)
             let g = mesh.group_of_dim(&ms.group, 3)?;
             mesh.check_orientation(g)?;
             for &c in &g.cells {
