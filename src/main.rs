@@ -79,6 +79,25 @@ enum Cmd {
         #[arg(long)]
         duration: Option<f64>,
     },
+    /// Natural frequencies and mode shapes of a scene's model: massless blocks condensed, the
+    /// reservoir's added mass included (docs/dam_physics.md). Writes <out>/modes/modes.pvd,
+    /// mode_NNN.vtu and modes.json.
+    Modes {
+        /// Scene file (JSON, see docs/scenes.md).
+        scene: PathBuf,
+        /// Number of modes (lowest first).
+        #[arg(short = 'n', long = "count", default_value_t = 6)]
+        count: usize,
+        /// Output directory (default: the scene's output.dir, else out/<name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Mesh cache directory.
+        #[arg(long, default_value = "build/mesh")]
+        cache: PathBuf,
+        /// Print the report as JSON instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Tag the joints of a scene (slave/master, normals, Layer1/Layer2, NTN pairs) and write
     /// <out>/tagging/joints.json, one <joint>.vtu per joint and summary.json.
     ///
@@ -387,6 +406,19 @@ fn real_main() -> Result<()> {
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration, threads };
             let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
             say_raw!("{}", summary.to_text());
+        }
+        Cmd::Modes { scene, count, out, cache, json } => {
+            let s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
+            let opts = RunOptions { mesh_cache: Some(cache), ..Default::default() };
+            let mesh = jointquake::pipeline::load_mesh(&s, &opts).with_context(|| format!("meshing scene {}", scene.display()))?;
+            let out_dir = out.unwrap_or_else(|| s.output_dir());
+            let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
+            let r = jointquake::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;
+            if json {
+                say!("{}", serde_json::to_string_pretty(&r).context("serialising the modes")?);
+            } else {
+                say_raw!("{}", r.to_text());
+            }
         }
         Cmd::Tag { scene, out, cache, json } => {
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: None, threads: None };

@@ -30,17 +30,14 @@ pub struct Problem {
 impl Problem {
     /// Build the model, the joints and the loads of `scene` on `mesh`.
     pub fn build(scene: Scene, mesh: Mesh) -> Result<Problem, Error> {
-        for ms in &scene.materials {
-            if ms.rho == 0.0 {
-                return Err(ModelError::Invalid(format!(
-                    "material \"{}\": rho = 0 (massless foundation) needs static condensation, which this version does not provide; give the foundation a density",
-                    ms.group
-                ))
-                .into());
-            }
+        let mut model = Model::build(mesh, &scene)?;
+        let mut notes = Vec::new();
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.added_mass) {
+            notes.push(add_reservoir_mass(&mut model, &scene, r)?);
         }
-        let model = Model::build(mesh, &scene)?;
-        Problem::from_model(scene, model)
+        let mut p = Problem::from_model(scene, model)?;
+        p.notes.extend(notes);
+        Ok(p)
     }
 
     /// The joints and loads of `scene` on a built model.
@@ -49,4 +46,30 @@ impl Problem {
         let (loads, notes) = Loads::build(&model, &scene)?;
         Ok(Problem { scene, model, joints, loads, notes })
     }
+}
+
+/// Add the reservoir's Westergaard/Kuo added mass m_a n nᵀ (`crate::reservoir`) to the inertia
+/// of the wet nodes (no weight); a note with the total.
+pub fn add_reservoir_mass(model: &mut Model, scene: &Scene, r: &crate::scene::ReservoirScene) -> Result<String, Error> {
+    let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
+    let mut faces = Vec::new();
+    for g in &r.faces {
+        faces.extend(crate::reservoir::wet_faces(&model.mesh, g, &volume)?);
+    }
+    let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
+    let added = crate::reservoir::added_masses(&model.mesh, &faces, &spec);
+    let mut total = 0.0;
+    for a in &added {
+        if model.mass.inertial[a.node] == 0.0 {
+            return Err(ModelError::Invalid(format!(
+                "reservoir: wet node {} has no structural mass (is the wet face on a massless block?): the added mass goes on the dam's face",
+                model.mesh.node_tags[a.node]
+            ))
+            .into());
+        }
+        let n = nalgebra::Vector3::from(a.normal);
+        model.add_inertia(a.node, n * n.transpose() * a.mass);
+        total += a.mass;
+    }
+    Ok(format!("reservoir: added mass {:.4e} kg on {} wet nodes (depth {:.3} m, Westergaard/Kuo)", total, added.len(), spec.depth()))
 }

@@ -37,6 +37,37 @@ pub struct Scene {
     /// Standard gravity used to convert records from g [m/s²]. Default 9.81.
     #[serde(default = "default_g")]
     pub g: f64,
+    /// Reservoir on wet face groups: hydrostatic pressure and added mass (docs/dam_physics.md).
+    #[serde(default)]
+    pub reservoir: Option<ReservoirScene>,
+}
+
+/// The reservoir of a dam (incompressible water; `crate::reservoir`).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReservoirScene {
+    /// Wet face groups (dim 2) on the outer surface of the dam, e.g. `["dam:upstream"]`.
+    pub faces: Vec<String>,
+    /// Pool level z_w [m] (z up).
+    pub level: f64,
+    /// Water density ρw [kg/m³]. Default 1000 (fresh water).
+    #[serde(default = "default_rho_w")]
+    pub rho_w: f64,
+    /// Reservoir bottom at the dam z_b [m] (depth H = z_w − z_b). Default: the lowest node of
+    /// the wet faces.
+    #[serde(default)]
+    pub bottom: Option<f64>,
+    /// Hydrostatic pressure ρw g (z_w − z), applied with gravity before the record and kept on.
+    /// Default true.
+    #[serde(default = "yes")]
+    pub hydrostatic: bool,
+    /// Westergaard/Kuo added mass along the face normal (inertia, not weight). Default true.
+    #[serde(default = "yes")]
+    pub added_mass: bool,
+}
+
+fn default_rho_w() -> f64 {
+    1000.0
 }
 
 fn default_g() -> f64 {
@@ -68,8 +99,13 @@ pub struct MaterialSpec {
     pub e: f64,
     /// Poisson's ratio [-], 0 ≤ ν < 0.5.
     pub nu: f64,
-    /// Density [kg/m³]. 0 makes the group massless (foundation); it then needs no time step.
+    /// Density [kg/m³]. With `massless` it is used only by the thin layer of elements along a
+    /// joint face on the block (docs/dam_physics.md).
     pub rho: f64,
+    /// Massless block (foundation): stiffness only, no mass, no weight, no base force, no stable
+    /// step; its unknowns are condensed statically every step. Default false.
+    #[serde(default)]
+    pub massless: bool,
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -609,6 +645,9 @@ impl Scene {
             if !(m.rho >= 0.0 && m.rho.is_finite()) {
                 return Err(format!("material \"{}\": rho = {} must be ≥ 0 [kg/m³]", m.group, m.rho));
             }
+            if m.rho == 0.0 && !m.massless {
+                return Err(format!("material \"{}\": rho = 0; a block without mass is declared with `\"massless\": true` (a massless foundation, condensed statically), else give its density", m.group));
+            }
             if m.rho > 0.0 && !(RHO_RANGE.0..=RHO_RANGE.1).contains(&m.rho) {
                 return Err(format!(
                     "material \"{}\": rho = {:e} kg/m³ is outside {:e}–{:e} kg/m³. Density is in kg/m³ (rock about 2000–3000).",
@@ -737,6 +776,22 @@ impl Scene {
             }
         }
         self.damping.coefficients()?;
+        if let Some(r) = &self.reservoir {
+            if r.faces.is_empty() {
+                return Err("reservoir.faces: name at least one wet face group".into());
+            }
+            if !(r.rho_w > 0.0 && r.rho_w.is_finite()) {
+                return Err(format!("reservoir.rho_w = {} must be positive [kg/m³]", r.rho_w));
+            }
+            if !r.level.is_finite() {
+                return Err("reservoir.level must be a finite height [m]".into());
+            }
+            if let Some(b) = r.bottom {
+                if !(b < r.level) {
+                    return Err(format!("reservoir.bottom = {b} m must be below the pool level {} m", r.level));
+                }
+            }
+        }
         if !(self.g > 0.0) {
             return Err(format!("g = {} must be positive [m/s²]", self.g));
         }

@@ -86,6 +86,9 @@ pub struct Loads {
     pub gravity_nodes: Option<Vec<bool>>,
     pub base: Vec<BaseMotion>,
     pub patterns: Vec<ForcePattern>,
+    /// Forces that act with gravity (before the record, ramped in with it during relaxation,
+    /// and kept on): the reservoir's hydrostatic pressure [N] per node.
+    pub static_forces: Vec<(usize, [f64; 3])>,
 }
 
 impl Loads {
@@ -127,7 +130,19 @@ impl Loads {
             notes.push(format!("nodal force at ({:?}) snapped to node {} at distance {:.3e} m", nf.point, model.mesh.node_tags[node], dist));
             patterns.push(ForcePattern { forces: vec![(node, nf.force)], ramp: nf.ramp });
         }
-        Ok((Loads { gravity, gravity_nodes, base, patterns }, notes))
+        let mut static_forces = Vec::new();
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic) {
+            let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
+            let mut faces = Vec::new();
+            for g in &r.faces {
+                faces.extend(crate::reservoir::wet_faces(&model.mesh, g, &volume)?);
+            }
+            let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
+            static_forces = crate::reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
+            let total: f64 = static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
+            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), static_forces.len(), total));
+        }
+        Ok((Loads { gravity, gravity_nodes, base, patterns, static_forces }, notes))
     }
 
     /// Ground acceleration vector a_g(t) [m/s²].
@@ -177,6 +192,13 @@ impl Loads {
                 let fb = b.added * agv;
                 for c in 0..3 {
                     f[3 * b.node as usize + c] -= fb[c];
+                }
+            }
+        }
+        if with_gravity {
+            for &(n, fv) in &self.static_forces {
+                for i in 0..3 {
+                    f[3 * n + i] += fv[i];
                 }
             }
         }

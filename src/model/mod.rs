@@ -103,6 +103,18 @@ pub struct Model {
     pub mass_damped: Vec<bool>,
     pub beta: f64,
     pub critical: CriticalElement,
+    /// Per material: a massless block (stiffness only; the foundation module condenses it).
+    pub massless: Vec<bool>,
+    /// Per node: the components condensed statically (nodes of massless blocks without mass,
+    /// components not fixed by the boundary conditions); such nodes are also in `fixed` (7), so
+    /// the explicit update leaves them to the condensation. 0 elsewhere.
+    pub condensed: Vec<u8>,
+    /// Per mesh cell: an element of a massless block (not of its layer along a joint): stiffness
+    /// only, no mass, no stable step.
+    pub massless_cells: Vec<bool>,
+    /// Per node: carries mass but no weight (its mass comes only from the layer of a massless
+    /// block's elements along a joint face: docs/dam_physics.md).
+    pub weightless: Vec<bool>,
 }
 
 /// Scatter target shared across threads. Safe use requires that no two concurrent writers touch
@@ -286,6 +298,7 @@ impl Model {
         // material of every mesh cell (u32::MAX: none)
         let mut owner = vec![u32::MAX; mesh.cells.len()];
         for (mi, ms) in scene.materials.iter().enumerate() {
+            // rho = 0 without `massless`: nodes without inertia, held (the scene loader refuses it)
             let g = mesh.group_of_dim(&ms.group, 3)?;
             mesh.check_orientation(g)?;
             for &c in &g.cells {
@@ -312,6 +325,22 @@ impl Model {
         let mut shapes: Vec<HexShape> = Vec::new();
         let mut shape_key: HashMap<(usize, [i64; 21]), u32> = HashMap::new();
         let mut mass = vec![0.0; n];
+        // mass from the elements of massive blocks alone (a node with only layer mass is weightless)
+        let mut massive_mass = vec![0.0; n];
+        let massless: Vec<bool> = scene.materials.iter().map(|m| m.massless).collect();
+        // nodes of the joint faces: the elements of a massless block that touch one keep their
+        // mass (the thin massive layer along a joint on a massless block, docs/dam_physics.md)
+        let mut joint_node = vec![false; n];
+        if massless.iter().any(|&m| m) {
+            for js in &scene.joints {
+                for g in [&js.master, &js.slave] {
+                    for node in mesh.group_nodes(g)? {
+                        joint_node[node] = true;
+                    }
+                }
+            }
+        }
+        let mut element_massless_cell = vec![false; mesh.cells.len()];
         let mut active = vec![false; n];
         let inverted = |c: usize, mi: usize| -> crate::Error {
             MeshError::InvertedElement {
@@ -329,13 +358,25 @@ impl Model {
             }
             let mi = mi as usize;
             let cell = &mesh.cells[c];
-            let rho = materials[mi].rho;
+            let layer = massless[mi] && cell.nodes().iter().any(|&v| joint_node[v as usize]);
+            if layer && materials[mi].rho == 0.0 {
+                return Err(ModelError::Invalid(format!(
+                    "material \"{}\" is massless with rho = 0, but element {} touches a joint face: a joint on a massless block needs the density of the block's layer along the joint (give `rho`; docs/dam_physics.md)",
+                    materials[mi].group, cell.tag
+                ))
+                .into());
+            }
+            let rho = if massless[mi] && !layer { 0.0 } else { materials[mi].rho };
+            element_massless_cell[c] = massless[mi] && !layer;
             match cell.kind {
                 CellKind::Tet4 => {
                     // geometry recomputed in assembly order below (not stored twice)
                     let g = tet4::tet_geometry(&tet_x(cell.nodes())).ok_or_else(|| inverted(c, mi))?;
                     for a in 0..4 {
                         mass[cell.node(a)] += rho * g.vol / 4.0;
+                        if !massless[mi] {
+                            massive_mass[cell.node(a)] += rho * g.vol / 4.0;
+                        }
                         active[cell.node(a)] = true;
                     }
                     tn.push(std::array::from_fn(|a| cell.nodes()[a]));
@@ -366,6 +407,9 @@ impl Model {
                     let s = &shapes[id as usize];
                     for a in 0..8 {
                         mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
+                        if !massless[mi] {
+                            massive_mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
+                        }
                         active[cell.node(a)] = true;
                     }
                     hn.push(std::array::from_fn(|a| cell.nodes()[a]));
@@ -403,12 +447,29 @@ impl Model {
 
         // ---- boundary conditions
         let mut fixed: Vec<u8> = active.iter().map(|&a| if a { 0 } else { 7 }).collect();
+        // nodes of the massless elements (without mass: condensed)
+        let mut condensed = vec![0u8; n];
+        for (c, &ml) in element_massless_cell.iter().enumerate() {
+            if ml {
+                for &v in mesh.cells[c].nodes() {
+                    if mass[v as usize] == 0.0 {
+                        condensed[v as usize] = 7;
+                    }
+                }
+            }
+        }
         for b in &scene.boundary {
             let bits = b.fix.iter().fold(0u8, |acc, c| acc | match c.as_str() { "x" => 1, "y" => 2, _ => 4 });
             for node in mesh.group_nodes(&b.group)? {
                 fixed[node] |= bits;
+                condensed[node] &= !bits;
             }
         }
+        if mass.iter().all(|&m| m == 0.0) {
+            return Err(ModelError::Invalid("every material group is massless: nothing carries mass to integrate in time (a massless block supports a massive one)".into()).into());
+        }
+        let weightless: Vec<bool> = (0..n).map(|i| mass[i] > 0.0 && massive_mass[i] == 0.0).collect();
+        drop(massive_mass);
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
         let mass_damped = match &scene.damping.mass_groups {
             None => vec![true; n],
@@ -429,16 +490,33 @@ impl Model {
             materials,
             tets,
             hexes,
-            mass: NodalMass::lumped(mass),
+            mass: {
+                // the layer of a massless block along a joint: inertia, no weight
+                let weight: Option<Vec<f64>> = weightless.iter().any(|&w| w).then(|| mass.iter().zip(&weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect());
+                let mut m = NodalMass::lumped(mass);
+                if let Some(g) = weight {
+                    m.set_gravitational(g);
+                }
+                m
+            },
             fixed,
             held,
             alpha,
             mass_damped,
             beta,
             critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
+            massless,
+            massless_cells: element_massless_cell,
+            condensed,
+            weightless,
         };
         model.critical = model.max_element_eigenvalue();
         Ok(model)
+    }
+
+    /// Whether the model has massless blocks to condense.
+    pub fn has_massless(&self) -> bool {
+        self.massless.iter().any(|&m| m)
     }
 
     pub fn n_nodes(&self) -> usize {
@@ -473,8 +551,13 @@ impl Model {
     /// The element with the largest ω²_max (element eigenvalue theorem: the global ω_max is bounded
     /// by the largest element ω_max with lumped mass).
     fn max_element_eigenvalue(&self) -> CriticalElement {
+        // an element of a massless block sets no stable step (its nodes are condensed, or carry
+        // the mass of other elements: the foundation's bound on them is the foundation module's);
+        // its layer elements along a joint have their mass and count as usual
+        let pure_massless = |cell: u32| self.massless_cells[cell as usize];
         let t = (0..self.tets.nodes.len())
             .into_par_iter()
+            .filter(|&e| !pure_massless(self.tets.cell[e]))
             .map(|e| {
                 let m = &self.materials[self.tets.mat[e] as usize];
                 let g = &self.tets.geom[e];
@@ -503,6 +586,9 @@ impl Model {
             .collect();
         let mut best = t;
         for e in 0..self.hexes.nodes.len() {
+            if pure_massless(self.hexes.cell[e]) {
+                continue;
+            }
             let w = shape_omega[self.hexes.shape[e] as usize];
             let c = self.hexes.cell[e] as usize;
             if w > best.0 || (w == best.0 && c < best.1) {
@@ -632,4 +718,12 @@ impl Model {
         let m = if e < nt { self.tets.mat[e] } else { self.hexes.mat[e - nt] };
         &self.materials[m as usize].lame
     }
+}
+
+/// The reservoir of a scene on its wet faces: ρw, pool level, bottom (default: the lowest wet
+/// node), g (the scene's gravity, else its standard g).
+pub fn reservoir_spec(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[crate::reservoir::WetFace], scene: &Scene) -> crate::reservoir::ReservoirSpec {
+    let lowest = faces.iter().flat_map(|f| f.nodes.iter()).map(|&v| mesh.nodes[v][2]).fold(f64::INFINITY, f64::min);
+    let g = scene.loads.gravity.as_ref().map(|g| g.g).unwrap_or(scene.g);
+    crate::reservoir::ReservoirSpec { rho_w: r.rho_w, level: r.level, bottom: r.bottom.unwrap_or(lowest), g }
 }

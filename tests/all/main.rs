@@ -8,6 +8,7 @@ mod dam;
 mod common;
 mod contact;
 mod contact_validation;
+mod dam_physics;
 mod dynamics;
 mod fuzz;
 mod mesh;

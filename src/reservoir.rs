@@ -1,0 +1,321 @@
+//! Reservoir loads on a wet face group (incompressible water): hydrostatic nodal forces and
+//! the Westergaard/Kuo generalised added mass. Pure functions of the mesh and the face group.
+//!
+//! Conventions (written once, here): z is up (design §2); the pool level z_w and the reservoir
+//! bottom z_b are heights [m], H = z_w − z_b the depth at the dam; the wet faces are oriented
+//! **out of the structure** (towards the water), found from the volume cell each face bounds;
+//! the water pushes along −n_out.
+//!
+//! - Hydrostatic: p(z) = ρw g (z_w − z) for z < z_w (0 above), consistent nodal forces
+//!   f_a = −∫ N_a p n_out dA, integrated exactly (p is linear, N_a and the Jacobian bilinear:
+//!   3-point rule on tri3, 2×2 Gauss on quad4). A face cut by the water line (p has a kink) is
+//!   integrated by a composite rule (quad4: 16 × 16 cells of 2×2 points; tri3: 1024
+//!   sub-triangles of 3 points): the resultant of a wall whose water line cuts a row of faces
+//!   is within 1e-5 relative (test), far below the mesh's own error.
+//! - Added mass (Westergaard 1933 for a vertical face; generalised by Kuo 1982, UCB/EERC-82/09,
+//!   for curved faces): at each wet node a, m_a = (7/8) ρw √(H (z_w − z_a)) A_a with A_a = ∫ N_a
+//!   dA its tributary area, acting along the nodal normal n_a only: the node's inertia gains the
+//!   3×3 block m_a n_a n_aᵀ (nothing tangentially). n_a is the normalised ∫ N_a n dA over the
+//!   wet faces. For a rigid vertical wall the total is (7/12) ρw H² per unit width (the nodal
+//!   sum converges to it as h^1.5: −0.9 % at 10 nodes over H, −0.3 % at 20).
+//!
+//! What incompressible water leaves out: the compressibility of the water (the reservoir's own
+//! resonances, at f_r = c/(4H) ≈ 1440/(4H) Hz: 3.6 Hz for H = 100 m) and the energy radiated
+//! upstream or absorbed by the reservoir bottom sediments. Both matter when the dam's
+//! fundamental frequency is close to or above f_r (tall dams, stiff rock); the added-mass model
+//! then misses the resonance peaks (Fenves & Chopra 1984; Chopra's "Earthquake Engineering for
+//! Concrete Dams", 2020). Below f_r the added mass is the standard practice (USACE EM 1110-2-6051).
+
+use crate::error::ModelError;
+use crate::mesh::topology::{orient_face, volume_faces};
+use crate::mesh::{CellKind, Mesh};
+use nalgebra::Vector3;
+
+/// The reservoir as seen by one wet face group.
+#[derive(Clone, Copy, Debug)]
+pub struct ReservoirSpec {
+    /// Water density ρw [kg/m³]. Default 1000.
+    pub rho_w: f64,
+    /// Pool level z_w [m].
+    pub level: f64,
+    /// Reservoir bottom at the dam z_b [m] (H = z_w − z_b).
+    pub bottom: f64,
+    /// Acceleration of gravity [m/s²].
+    pub g: f64,
+}
+
+impl ReservoirSpec {
+    /// Depth H [m].
+    pub fn depth(&self) -> f64 {
+        self.level - self.bottom
+    }
+
+    /// Hydrostatic pressure at height z [Pa] (0 above the pool).
+    pub fn pressure(&self, z: f64) -> f64 {
+        self.rho_w * self.g * (self.level - z).max(0.0)
+    }
+}
+
+/// A wet face: its kind and nodes in outward order (out of the structure, towards the water).
+#[derive(Clone, Debug)]
+pub struct WetFace {
+    pub kind: CellKind,
+    pub nodes: Vec<usize>,
+}
+
+/// The faces of `group` (dim 2), each oriented out of the volume cell of `volume_cells` it
+/// bounds. Errors name the group and the face that bounds no volume (or two).
+pub fn wet_faces(mesh: &Mesh, group: &str, volume_cells: &[usize]) -> Result<Vec<WetFace>, crate::Error> {
+    let g = mesh.group_of_dim(group, 2)?;
+    if g.cells.is_empty() {
+        return Err(ModelError::Invalid(format!("reservoir face group \"{group}\" has no faces")).into());
+    }
+    let map = volume_faces(mesh, volume_cells);
+    let mut out = Vec::with_capacity(g.cells.len());
+    for &c in &g.cells {
+        match orient_face(mesh, &map, c) {
+            Some(f) => out.push(WetFace { kind: mesh.cells[c].kind, nodes: f.nodes }),
+            None => {
+                return Err(ModelError::Invalid(format!(
+                    "reservoir face group \"{group}\": face {} is not on the boundary of exactly one element of the material groups; the wet face must be the outer surface of the dam",
+                    mesh.cells[c].tag
+                ))
+                .into())
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Quadrature points of a face on the reference element: (shape values N_a, ∂x/∂s × ∂x/∂t
+/// (area-weighted normal, outward for outward node order) × weight), for a function with a
+/// kink (`composite`) or not.
+fn face_points(kind: CellKind, x: &[Vector3<f64>], composite: bool) -> Vec<([f64; 4], Vector3<f64>)> {
+    let mut pts = Vec::new();
+    match kind {
+        CellKind::Quad4 => {
+            let r = crate::mesh::cell::QUAD4_REF;
+            let cells = if composite { 16 } else { 1 };
+            let gp = 1.0 / 3f64.sqrt();
+            let h = 2.0 / cells as f64;
+            for ci in 0..cells {
+                for cj in 0..cells {
+                    for &a in &[-gp, gp] {
+                        for &b in &[-gp, gp] {
+                            let s = -1.0 + h * (ci as f64 + 0.5 * (a + 1.0));
+                            let t = -1.0 + h * (cj as f64 + 0.5 * (b + 1.0));
+                            let mut dxs = Vector3::zeros();
+                            let mut dxt = Vector3::zeros();
+                            let mut n = [0.0; 4];
+                            for k in 0..4 {
+                                n[k] = 0.25 * (1.0 + s * r[k][0]) * (1.0 + t * r[k][1]);
+                                dxs += x[k] * 0.25 * r[k][0] * (1.0 + t * r[k][1]);
+                                dxt += x[k] * 0.25 * r[k][1] * (1.0 + s * r[k][0]);
+                            }
+                            // weight of one Gauss point: (h/2)² in reference units
+                            pts.push((n, dxs.cross(&dxt) * (0.25 * h * h)));
+                        }
+                    }
+                }
+            }
+        }
+        CellKind::Tri3 => {
+            let an = (x[1] - x[0]).cross(&(x[2] - x[0])) * 0.5;
+            // sub-triangles of the reference triangle (barycentric corners), then the 3-point
+            // edge-midpoint rule (degree 2) on each
+            let mut tris: Vec<[[f64; 3]; 3]> = vec![[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]];
+            if composite {
+                for _ in 0..5 {
+                    let mut next = Vec::with_capacity(4 * tris.len());
+                    for t in &tris {
+                        let mid = |i: usize, j: usize| -> [f64; 3] { std::array::from_fn(|k| 0.5 * (t[i][k] + t[j][k])) };
+                        let (m01, m12, m20) = (mid(0, 1), mid(1, 2), mid(2, 0));
+                        next.push([t[0], m01, m20]);
+                        next.push([m01, t[1], m12]);
+                        next.push([m20, m12, t[2]]);
+                        next.push([m01, m12, m20]);
+                    }
+                    tris = next;
+                }
+            }
+            let w = an / (3.0 * tris.len() as f64);
+            for t in &tris {
+                for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                    let l: [f64; 3] = std::array::from_fn(|k| 0.5 * (t[i][k] + t[j][k]));
+                    pts.push(([l[0], l[1], l[2], 0.0], w));
+                }
+            }
+        }
+        _ => {}
+    }
+    pts
+}
+
+/// Consistent hydrostatic nodal forces [N] on the wet faces, summed per node, by node index.
+pub fn hydrostatic_forces(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Vec<(usize, [f64; 3])> {
+    let mut acc: std::collections::BTreeMap<usize, Vector3<f64>> = Default::default();
+    for f in faces {
+        let x: Vec<Vector3<f64>> = f.nodes.iter().map(|&n| mesh.x(n)).collect();
+        let (zmin, zmax) = x.iter().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p[2]), b.max(p[2])));
+        if zmin >= spec.level {
+            continue;
+        }
+        let cut = zmax > spec.level;
+        for (nsh, da) in face_points(f.kind, &x, cut) {
+            let z: f64 = (0..f.nodes.len()).map(|a| nsh[a] * x[a][2]).sum();
+            let p = spec.pressure(z);
+            for (a, &node) in f.nodes.iter().enumerate() {
+                *acc.entry(node).or_insert_with(Vector3::zeros) -= da * (nsh[a] * p);
+            }
+        }
+    }
+    acc.into_iter().map(|(n, v)| (n, [v[0], v[1], v[2]])).collect()
+}
+
+/// Added mass of one wet node.
+#[derive(Clone, Copy, Debug)]
+pub struct AddedMass {
+    pub node: usize,
+    /// m_a [kg].
+    pub mass: f64,
+    /// Unit normal n (out of the structure).
+    pub normal: [f64; 3],
+    /// Tributary area A_a [m²].
+    pub area: f64,
+}
+
+impl AddedMass {
+    /// The inertia block m_a n nᵀ [kg].
+    pub fn block(&self) -> [[f64; 3]; 3] {
+        let n = self.normal;
+        std::array::from_fn(|i| std::array::from_fn(|j| self.mass * n[i] * n[j]))
+    }
+}
+
+/// Westergaard/Kuo added mass of every wet node below the pool level, by node index.
+pub fn added_masses(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Vec<AddedMass> {
+    let mut acc: std::collections::BTreeMap<usize, (f64, Vector3<f64>)> = Default::default();
+    for f in faces {
+        let x: Vec<Vector3<f64>> = f.nodes.iter().map(|&n| mesh.x(n)).collect();
+        for (nsh, da) in face_points(f.kind, &x, false) {
+            for (a, &node) in f.nodes.iter().enumerate() {
+                let e = acc.entry(node).or_insert((0.0, Vector3::zeros()));
+                e.0 += nsh[a] * da.norm();
+                e.1 += da * nsh[a];
+            }
+        }
+    }
+    let h = spec.depth();
+    acc.into_iter()
+        .filter_map(|(node, (area, nsum))| {
+            let depth = spec.level - mesh.nodes[node][2];
+            if depth <= 0.0 || !(nsum.norm() > 0.0) {
+                return None;
+            }
+            let n = nsum.normalize();
+            let mass = 0.875 * spec.rho_w * (h * depth).sqrt() * area;
+            Some(AddedMass { node, mass, normal: [n[0], n[1], n[2]], area })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::structured::{box_mesh, BoxSpec};
+
+    fn wall(nz: usize, tets: bool) -> (Mesh, Vec<WetFace>) {
+        // a 3 m wide (y), 10 m high (z) wall, 2 m thick (x); wet face x0 (water on x < 0)
+        let mesh = box_mesh(&BoxSpec::new("w", [2.0, 3.0, 10.0], [2, 3, nz]).tets(tets));
+        let vol = mesh.group("block:w").unwrap().cells.clone();
+        let faces = wet_faces(&mesh, "w:x0", &vol).unwrap();
+        (mesh, faces)
+    }
+
+    #[test]
+    fn hydrostatic_resultant_and_its_height_on_a_vertical_face() {
+        // Reference: F = ½ ρw g H² b along +x (into the wall), acting at H/3 above the base;
+        // tolerance 1e-9 relative (the rule is exact for a linear pressure). Pool at the crest
+        // (H = 10 m, no cut face) and at 7 m (H = 7 m: the faces between 6.25 and 7.5 m are cut by the water line, composite rule).
+        for tets in [false, true] {
+            for (level, tol) in [(10.0, 1e-9), (7.0, 1e-5)] {
+                let (mesh, faces) = wall(8, tets);
+                let spec = ReservoirSpec { rho_w: 1000.0, level, bottom: 0.0, g: 9.81 };
+                let f = hydrostatic_forces(&mesh, &faces, &spec);
+                let (mut fx, mut fy, mut fz, mut mz) = (0.0, 0.0, 0.0, 0.0);
+                for &(n, v) in &f {
+                    fx += v[0];
+                    fy += v[1];
+                    fz += v[2];
+                    mz += v[0] * mesh.nodes[n][2];
+                }
+                let h = level;
+                let exact = 0.5 * 1000.0 * 9.81 * h * h * 3.0;
+                assert!((fx - exact).abs() < tol * exact, "tets {tets} level {level}: Fx {fx} exact {exact}");
+                assert!(fy.abs() < 1e-12 * exact && fz.abs() < 1e-12 * exact);
+                let zr = mz / fx;
+                assert!((zr - h / 3.0).abs() < tol * h, "tets {tets} level {level}: resultant at {zr}, exact {}", h / 3.0);
+            }
+        }
+    }
+
+    #[test]
+    fn westergaard_total_on_a_rigid_vertical_wall() {
+        // Reference: Σ m_a = (7/12) ρw H² b for a vertical wall (Westergaard 1933); the nodal
+        // sum of √ converges as h^1.5: within 1 % at 10 nodes over H, 0.4 % at 20
+        for (nz, tol) in [(10, 0.01), (20, 0.004)] {
+            let (mesh, faces) = wall(nz, false);
+            let spec = ReservoirSpec { rho_w: 1000.0, level: 10.0, bottom: 0.0, g: 9.81 };
+            let m = added_masses(&mesh, &faces, &spec);
+            let total: f64 = m.iter().map(|a| a.mass).sum();
+            let exact = 7.0 / 12.0 * 1000.0 * 100.0 * 3.0;
+            assert!((total / exact - 1.0).abs() < tol, "nz {nz}: {total} vs {exact}");
+            // along the normal -x only (out of the wall, towards the water)
+            assert!(m.iter().all(|a| (a.normal[0] + 1.0).abs() < 1e-12));
+        }
+    }
+
+    #[test]
+    fn curved_face_gets_no_tangential_added_mass() {
+        // a quarter cylinder shell of radius 20 m (16 quads around, 5 up), wet on its outside:
+        // every block m_a n nᵀ has t·B t = 0 for t ⊥ n (1e-12 of m_a), n radial, and
+        // n·B n = m_a
+        let (r, nth, nz, hgt) = (20.0, 16usize, 5usize, 10.0);
+        let mut mesh = Mesh { source: "<cylinder>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
+        let id = |i: usize, k: usize| i + (nth + 1) * k;
+        for k in 0..=nz {
+            for i in 0..=nth {
+                let th = std::f64::consts::FRAC_PI_2 * i as f64 / nth as f64;
+                mesh.nodes.push([r * th.cos(), r * th.sin(), hgt * k as f64 / nz as f64]);
+                mesh.node_tags.push(mesh.nodes.len() as u64);
+            }
+        }
+        let mut faces = Vec::new();
+        for k in 0..nz {
+            for i in 0..nth {
+                // outward (radial) right-hand order
+                faces.push(WetFace { kind: CellKind::Quad4, nodes: vec![id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)] });
+            }
+        }
+        let spec = ReservoirSpec { rho_w: 1000.0, level: hgt, bottom: 0.0, g: 9.81 };
+        let m = added_masses(&mesh, &faces, &spec);
+        assert!(!m.is_empty());
+        for a in &m {
+            let x = mesh.nodes[a.node];
+            let radial = Vector3::new(x[0], x[1], 0.0).normalize();
+            let n = Vector3::from(a.normal);
+            // interior nodes: the nodal normal is radial (the end columns are one-sided)
+            let i = a.node % (nth + 1);
+            if i > 0 && i < nth {
+                assert!((n - radial).norm() < 1e-12, "node {}: normal {n:?} radial {radial:?}", a.node);
+            }
+            let b = nalgebra::Matrix3::from_fn(|i, j| a.block()[i][j]);
+            let t1 = Vector3::new(-n[1], n[0], 0.0).normalize();
+            let t2 = n.cross(&t1);
+            for t in [t1, t2] {
+                assert!((t.transpose() * b * t)[0].abs() < 1e-12 * a.mass, "tangential inertia at node {}", a.node);
+            }
+            assert!(((n.transpose() * b * n)[0] - a.mass).abs() < 1e-12 * a.mass);
+        }
+    }
+}

@@ -1,0 +1,311 @@
+//! Dam physics: massless foundation (static condensation), reservoir (hydrostatic, added mass),
+//! natural frequencies (docs/dam_physics.md). Each test states its reference and tolerance.
+
+use crate::common::{problem, scene, scratch};
+use jointquake::linalg::{dof_map, lowest_modes, mass_matrix, restrict, stiffness, ModesOptions, NONE};
+use jointquake::mesh::structured::{box_mesh, BoxSpec};
+use jointquake::mesh::{Group, Mesh};
+use jointquake::simulation::Simulation;
+
+/// A structured box whose cells are split into two volume groups: `block:<lower>` for cells
+/// with centroid z below `z_cut`, `block:<upper>` above (conforming: shared nodes).
+fn split_box(size: [f64; 3], div: [usize; 3], z_cut: f64, lower: &str, upper: &str) -> Mesh {
+    let mut m = box_mesh(&BoxSpec::new("b", size, div));
+    let cells = m.group("block:b").unwrap().cells.clone();
+    let (mut lo, mut hi) = (Vec::new(), Vec::new());
+    for c in cells {
+        let z: f64 = m.cells[c].nodes().iter().map(|&v| m.nodes[v as usize][2]).sum::<f64>() / 8.0;
+        if z < z_cut { lo.push(c) } else { hi.push(c) }
+    }
+    m.groups.retain(|g| g.name != "block:b");
+    m.groups.push(Group { name: format!("block:{lower}"), dim: 3, tag: 101, cells: lo });
+    m.groups.push(Group { name: format!("block:{upper}"), dim: 3, tag: 102, cells: hi });
+    m
+}
+
+/// The dense condensed problem on the dofs with mass: S = K_bb − K_bf K_ff⁻¹ K_fb and the
+/// lowest eigenvalue of M_b⁻¹ S (nalgebra, dense).
+fn dense_condensed_first_omega2(model: &jointquake::model::Model) -> f64 {
+    let k = stiffness(model, &vec![true; model.materials.len()]);
+    let n = 3 * model.n_nodes();
+    let free = |d: usize| model.is_free(d / 3, d % 3) && k.col_ptr[d + 1] > k.col_ptr[d];
+    let (bmap, nb) = dof_map(n, |d| free(d) && model.mass.inertial[d / 3] > 0.0);
+    let (fmap, nf) = dof_map(n, |d| free(d) && model.mass.inertial[d / 3] == 0.0);
+    let kd = |rm: &[usize], nr, cm: &[usize], nc| restrict(&k, rm, nr, cm, nc).to_dense();
+    let kbb = kd(&bmap, nb, &bmap, nb);
+    let kbf = kd(&bmap, nb, &fmap, nf);
+    let kff = kd(&fmap, nf, &fmap, nf);
+    let s = &kbb - &kbf * kff.cholesky().unwrap().solve(&kbf.transpose());
+    let mb = mass_matrix(&model.mass.inertial, &[], &bmap, nb).to_dense();
+    let li = mb.cholesky().unwrap().l().try_inverse().unwrap();
+    let a = &li * s * li.transpose();
+    let a = (&a + a.transpose()) * 0.5;
+    nalgebra::SymmetricEigen::new(a).eigenvalues.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+fn column_scene(extra: serde_json::Value) -> jointquake::scene::Scene {
+    // a 1 × 1 × 10 m massless column (E = 1 GPa, ν = 0) under a 1 m stiff heavy cap
+    // (E = 10⁴ GPa, ρ = 10⁵ kg/m³: m = 10⁵ kg), base fixed
+    let mut v = serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [
+            {"group": "block:col", "E": 1e9, "nu": 0.0, "rho": 2000.0, "massless": true},
+            {"group": "block:cap", "E": 1e13, "nu": 0.0, "rho": 1e5}
+        ],
+        "boundary": [{"group": "b:z0"}],
+        "time": {"duration": 1.0}
+    });
+    for (k, x) in extra.as_object().unwrap() {
+        v[k] = x.clone();
+    }
+    scene(v)
+}
+
+#[test]
+fn mass_on_a_massless_column_vibrates_at_the_static_stiffness() {
+    // Reference: 1 DOF, ω² = k/m with k = EA/L = 1e9 · 1 / 10 = 1e8 N/m, m = 10⁵ kg (the cap):
+    // ω = 31.623 rad/s, T = 0.19869 s (the cap's own flexibility shifts it by ~1e-4). A step
+    // traction on the cap's top gives u(t) = (F/k)(1 − cos ωt); the measured period (mean of
+    // three, from the crossings of the static value) within 1 %. Also: the condensed
+    // foundation carries no mass, so the cap's static deflection is F/k (1e-3).
+    let mesh = split_box([1.0, 1.0, 11.0], [1, 1, 11], 10.0, "col", "cap");
+    let sc = column_scene(serde_json::json!({"loads": {"traction": [{"group": "b:z1", "traction": [0.0, 0.0, -1e6]}]}}));
+    let pb = problem(mesh, &sc, 0.9);
+    let mut sim = Simulation::new(&pb).unwrap();
+    assert!(sim.foundation.is_some(), "the massless column is condensed");
+    let top: Vec<usize> = pb.model.mesh.group_nodes("b:z1").unwrap();
+    let (k, m, f) = (1e8, 1e5, 1e6);
+    let static_u = -f / k;
+    let w = (k / m as f64).sqrt();
+    let dt = sim.dt();
+    let steps = (3.2 * 2.0 * std::f64::consts::PI / w / dt) as usize;
+    let mut prev = 0.0;
+    let mut crossings = Vec::new();
+    let mut peak = 0.0f64;
+    for _ in 0..steps {
+        sim.step().unwrap();
+        let u = top.iter().map(|&n| sim.state.u[3 * n + 2]).sum::<f64>() / top.len() as f64;
+        peak = peak.min(u);
+        let (a, b) = (prev - static_u, u - static_u);
+        if a > 0.0 && b <= 0.0 || a < 0.0 && b >= 0.0 {
+            let t = sim.state.t - dt * b / (b - a);
+            crossings.push(t);
+        }
+        prev = u;
+    }
+    assert!(crossings.len() >= 6, "crossings {crossings:?}");
+    // crossings every half period: T = 2 (t_{i+2} − t_i)/2
+    let periods: Vec<f64> = (0..crossings.len() - 2).step_by(2).map(|i| crossings[i + 2] - crossings[i]).collect();
+    let t_mean = periods.iter().sum::<f64>() / periods.len() as f64;
+    let t_exact = 2.0 * std::f64::consts::PI / w;
+    println!("massless column: T = {t_mean:.6} s, exact {t_exact:.6} s ({:+.3} %), peak {peak:.4e} m (2 F/k = {:.4e})", 100.0 * (t_mean / t_exact - 1.0), 2.0 * static_u);
+    assert!((t_mean / t_exact - 1.0).abs() < 0.01, "period {t_mean} vs {t_exact}");
+    assert!((peak / (2.0 * static_u) - 1.0).abs() < 0.01, "peak {peak} vs 2F/k {}", 2.0 * static_u);
+}
+
+#[test]
+fn modes_of_the_massless_column_are_the_condensed_one_dof() {
+    // Reference: the dense condensed problem (S = K_bb − K_bf K_ff⁻¹ K_fb, M_b) solved with
+    // nalgebra: the sparse shift-invert Lanczos on the full K with the singular M gives the same
+    // ω² to 1e-7 (both direct; the cap is 10⁴ times stiffer than the column, so the dense
+    // Schur complement loses about 8 digits: measured 1e-8); and ω² = (EA/L)/m within 1e-3 (the cap's flexibility, 1e-4, and its
+    // rotational inertia in the bending modes do not enter the axial mode)
+    let mesh = split_box([1.0, 1.0, 11.0], [1, 1, 11], 10.0, "col", "cap");
+    let pb = problem(mesh, &column_scene(serde_json::json!({})), 0.9);
+    let model = &pb.model;
+    let k = stiffness(model, &vec![true; model.materials.len()]);
+    let n = 3 * model.n_nodes();
+    let (map, nf) = dof_map(n, |d| model.is_free(d / 3, d % 3));
+    let modes = lowest_modes(&restrict(&k, &map, nf, &map, nf), &mass_matrix(&model.mass.inertial, &[], &map, nf), &ModesOptions { count: 6, ..Default::default() }).unwrap();
+    let dense = dense_condensed_first_omega2(model);
+    assert!((modes.omega2[0] - dense).abs() < 1e-7 * dense, "first ω² {} vs dense condensed {dense}", modes.omega2[0]);
+    // the axial mode: the one whose shape is along z at the cap
+    let top = model.mesh.group_nodes("b:z1").unwrap()[0];
+    let axial = (0..modes.omega2.len())
+        .max_by(|&a, &b| {
+            let z = |i: usize| modes.shapes[i][map[3 * top + 2]].abs() / (modes.shapes[i][map[3 * top]].abs() + 1e-30);
+            z(a).total_cmp(&z(b))
+        })
+        .unwrap();
+    let exact = 1e8 / 1e5;
+    println!("massless column: axial mode {axial}, ω² = {:.6} (EA/(L m) = {exact})", modes.omega2[axial]);
+    assert!((modes.omega2[axial] / exact - 1.0).abs() < 1e-3);
+    assert!(map.iter().filter(|&&d| d != NONE).count() == nf);
+}
+
+#[test]
+fn block_on_a_massless_foundation_first_frequency_equals_the_dense_condensation() {
+    // Reference: the dense condensed stiffness S on the block's dofs (nalgebra), lowest
+    // eigenvalue of M⁻¹ S; the sparse Lanczos (full K, singular M) to 1e-6 relative. A 4 × 4 × 2
+    // m massless foundation (E = 20 GPa, ν = 0.25, base fixed) under a 4 × 4 × 1 m block
+    // (E = 25 GPa, ρ = 2400), hex8 4 × 4 × 3.
+    let mesh = split_box([4.0, 4.0, 3.0], [4, 4, 3], 2.0, "rock", "dam");
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [
+            {"group": "block:rock", "E": 2e10, "nu": 0.25, "rho": 2700.0, "massless": true},
+            {"group": "block:dam", "E": 2.5e10, "nu": 0.2, "rho": 2400.0}
+        ],
+        "boundary": [{"group": "b:z0"}],
+        "time": {"duration": 0.0}
+    }));
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let k = stiffness(model, &vec![true; model.materials.len()]);
+    let n = 3 * model.n_nodes();
+    let (map, nf) = dof_map(n, |d| model.is_free(d / 3, d % 3));
+    let modes = lowest_modes(&restrict(&k, &map, nf, &map, nf), &mass_matrix(&model.mass.inertial, &[], &map, nf), &ModesOptions { count: 3, ..Default::default() }).unwrap();
+    let dense = dense_condensed_first_omega2(model);
+    println!("block on massless rock: f1 = {:.6} Hz (dense condensed {:.6} Hz)", modes.frequency(0), dense.sqrt() / (2.0 * std::f64::consts::PI));
+    assert!((modes.omega2[0] - dense).abs() < 1e-6 * dense);
+    // the massless elements set no stable step: the critical element is in the dam
+    assert_eq!(model.critical.group, "block:dam");
+}
+
+/// A record file: linear ramp of the acceleration from 0 to `a_g` [g] over `ramp` s, then held.
+fn ramp_record(dir: &std::path::Path, a_g: f64, ramp: f64, end: f64) -> std::path::PathBuf {
+    let p = dir.join("ramp.txt");
+    let mut s = String::from("# t [s], a [g]\n");
+    let n = 400;
+    for i in 0..=n {
+        let t = end * i as f64 / n as f64;
+        s.push_str(&format!("{t} {}\n", a_g * (t / ramp).min(1.0)));
+    }
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+#[test]
+fn base_shear_of_a_stiff_block_with_a_wet_face_includes_the_westergaard_mass() {
+    // Reference: quasi-static rigid response to a uniform base acceleration a along x (the wet
+    // face's normal): base shear V = (M + (7/12) ρw H² b) a (Westergaard 1933), with M the
+    // block's mass, H = 10 m, b = 3 m. The base shear is the reaction at the fixed base, from
+    // the stiffness (Σ over the fixed x dofs of (K u)) plus the inertia of the base nodes, which
+    // move with the ground. Block 2 × 3 × 10 m, E = 10⁵ GPa (stiff: f1 ≈ 400 Hz), the record
+    // ramps to 0.2 g over 0.2 s and holds; V read at 0.3 s. Tolerance 1 % (the nodal added mass
+    // sum is −0.3 % low at 20 nodes over H; hydrostatic off, so V has no static part).
+    let dir = scratch("dam_base_shear");
+    let rec = ramp_record(&dir, 0.2, 0.2, 0.5);
+    let mesh = box_mesh(&BoxSpec::new("b", [2.0, 3.0, 10.0], [2, 3, 20]));
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [{"group": "block:b", "E": 1e14, "nu": 0.2, "rho": 2400.0}],
+        "boundary": [{"group": "b:z0"}],
+        "loads": {"base": [{"record": rec, "direction": [1.0, 0.0, 0.0]}]},
+        "damping": {"alpha": 20.0},
+        "reservoir": {"faces": ["b:x0"], "level": 10.0, "hydrostatic": false},
+        "time": {"duration": 0.3}
+    }));
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let mut sim = Simulation::new(&pb).unwrap();
+    let n_steps = sim.n_steps();
+    for _ in 0..n_steps {
+        sim.step().unwrap();
+    }
+    let mut ku = vec![0.0; 3 * model.n_nodes()];
+    model.internal_forces_into(&sim.state.u, &mut ku);
+    let a = 0.2 * 9.81;
+    let base = model.mesh.group_nodes("b:z0").unwrap();
+    // reaction on the structure at the base = −Σ (K u)_x there; plus the base nodes' inertia
+    let mut v = 0.0;
+    for &nd in &base {
+        v += ku[3 * nd];
+        v += model.mass.apply(nd, &nalgebra::Vector3::new(a, 0.0, 0.0))[0];
+    }
+    let m_total: f64 = model.mass.inertial.iter().sum();
+    let expect = (m_total + 7.0 / 12.0 * 1000.0 * 100.0 * 3.0) * a;
+    let dry = m_total * a;
+    println!("wet base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), dry {dry:.5e} N", 100.0 * (v / expect - 1.0));
+    assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs (M + 7/12 ρ H² b) a = {expect}");
+}
+
+#[test]
+fn modes_command_on_the_cantilever_fixture() {
+    // Reference: Euler–Bernoulli cantilever L = 10, b = h = 1 m (E = 1 GPa, ν = 0, ρ = 2000):
+    // ω1 = 1.875104² √(E I / (ρ A L⁴)) = 7.177 rad/s in both bending planes (square section),
+    // first-mode effective mass 0.6131 of the total (Chopra, Dynamics of Structures, cantilever
+    // mode 1). hex8 20 × 1 × 2 (tests/fixtures/cantilever_hex.msh): f within 3 %, the effective
+    // mass fraction within 3 % (of the mass the ground moves: the clamped nodes excluded).
+    let dir = scratch("dam_modes_cli");
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": crate::common::fixture("cantilever_hex.msh")},
+        "materials": [{"group": "block:beam", "E": 1e9, "nu": 0.0, "rho": 2000.0}],
+        "boundary": [{"group": "bc:fixed"}],
+        "time": {"duration": 0.0}
+    }));
+    let mesh = Mesh::from_msh(crate::common::fixture("cantilever_hex.msh")).unwrap();
+    let pb = problem(mesh, &sc, 0.9);
+    let r = jointquake::modes::modes(&pb, 4, &dir).unwrap();
+    let text = r.to_text();
+    println!("{text}");
+    let w1 = 1.875104f64.powi(2) * (1e9f64 / 12.0 / (2000.0 * 1e4)).sqrt();
+    let f1 = w1 / (2.0 * std::f64::consts::PI);
+    for m in &r.modes[..2] {
+        assert!((m.frequency_hz / f1 - 1.0).abs() < 0.03, "f = {} Hz vs Euler–Bernoulli {f1} Hz", m.frequency_hz);
+        assert!(m.residual < 1e-8);
+    }
+    // the two bending modes together carry 61.3 % of the mass along y and along z
+    for c in [1, 2] {
+        let frac: f64 = r.modes[..2].iter().map(|m| m.effective_fraction[c]).sum();
+        assert!((frac / 0.6131 - 1.0).abs() < 0.03, "direction {c}: effective fraction {frac}");
+    }
+    assert!(r.pvd.exists() && dir.join("modes/mode_004.vtu").exists() && dir.join("modes/modes.json").exists());
+    let pvd = std::fs::read_to_string(&r.pvd).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 4);
+}
+
+fn dam_on_rock_with_a_tied_joint(rho_rock: f64) -> (Mesh, jointquake::scene::Scene) {
+    // a 2 × 2 × 1 m dam block (hex 3 × 3 × 2) on a 4 × 4 × 3 m massless rock (hex 4 × 4 × 3):
+    // non-conforming, bonded by a tied NTS joint (master the rock's top, slave the dam's base)
+    let mut mesh = box_mesh(&BoxSpec::new("rock", [4.0, 4.0, 3.0], [4, 4, 3]));
+    jointquake::mesh::structured::add_box(&mut mesh, &BoxSpec::new("dam", [2.0, 2.0, 1.0], [3, 3, 2]).at([1.0, 1.0, 3.0]));
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [
+            {"group": "block:rock", "E": 2e10, "nu": 0.25, "rho": rho_rock, "massless": true},
+            {"group": "block:dam", "E": 2.5e10, "nu": 0.2, "rho": 2400.0}
+        ],
+        "boundary": [{"group": "rock:z0"}],
+        "loads": {"gravity": {}},
+        "joints": [{"name": "base", "master": "rock:z1", "slave": "dam:z0", "tied": true}],
+        "time": {"duration": 0.0}
+    }));
+    (mesh, sc)
+}
+
+#[test]
+fn tied_joint_on_a_massless_block_gets_a_weightless_massive_layer() {
+    // The decision of docs/dam_physics.md: the rock elements touching the joint keep their
+    // density (so the dynamic contact force has nodal masses on the master side) but no weight;
+    // the rest of the rock is condensed. Check: the layer nodes have mass and no weight, the
+    // condensed unknowns exist, and after gravity relaxation (residual 1e-6) the vertical
+    // reaction at the fixed rock base equals the dam's weight alone (ρ g V = 2400 · 9.81 · 4 N)
+    // to 1e-4: no weight from the rock or its layer, the load carried through the tied joint
+    // and the condensed rock.
+    let (mesh, sc) = dam_on_rock_with_a_tied_joint(2700.0);
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let top = model.mesh.group_nodes("rock:z1").unwrap();
+    assert!(top.iter().all(|&n| model.mass.inertial[n] > 0.0 && model.mass.weight_mass(n) == 0.0), "layer: mass, no weight");
+    assert!(model.condensed.iter().any(|&c| c != 0));
+    let mut sim = Simulation::new(&pb).unwrap();
+    assert!(sim.foundation.is_some());
+    let eq = sim.relax(1e-6, 200_000).unwrap();
+    assert!(eq.converged, "{eq:?}");
+    let mut ku = vec![0.0; 3 * model.n_nodes()];
+    model.internal_forces_into(&sim.state.u, &mut ku);
+    let base = model.mesh.group_nodes("rock:z0").unwrap();
+    let rz: f64 = base.iter().map(|&n| ku[3 * n + 2]).sum();
+    let weight = 2400.0 * 9.81 * 4.0;
+    println!("dam on massless rock, tied: base reaction {rz:.6e} N, dam weight {weight:.6e} N");
+    assert!((rz.abs() / weight - 1.0).abs() < 1e-4, "reaction {rz} vs weight {weight}");
+}
+
+#[test]
+fn joint_on_a_massless_block_without_density_is_a_clear_error() {
+    // rho = 0 leaves the joint's layer without mass: refused, naming the group and the fix
+    let (mesh, sc) = dam_on_rock_with_a_tied_joint(0.0);
+    let err = jointquake::problem::Problem::build(sc, mesh).unwrap_err().to_string();
+    assert!(err.contains("block:rock") && err.contains("joint") && err.contains("rho"), "{err}");
+}
