@@ -266,6 +266,19 @@ pub struct TimeSpec {
     /// Energy-balance tolerance (relative to the energy scale) above which the run stops. Default 0.05.
     #[serde(default = "default_energy_tol")]
     pub energy_tolerance: f64,
+    /// Largest number of dynamic steps a run may take. Default 10⁸ (`DEFAULT_MAX_STEPS`): about
+    /// 30 minutes of a 10⁴-element model on one core, and far beyond any run the pipelines
+    /// make; a run that would take more (a tiny dt, a huge duration) is refused up front with its
+    /// count, instead of running for ever. Raise it to allow such a run.
+    #[serde(default = "default_max_steps")]
+    pub max_steps: u64,
+}
+
+/// Default of `time.max_steps`.
+pub const DEFAULT_MAX_STEPS: u64 = 100_000_000;
+
+fn default_max_steps() -> u64 {
+    DEFAULT_MAX_STEPS
 }
 
 fn default_energy_tol() -> f64 {

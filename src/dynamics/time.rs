@@ -46,12 +46,20 @@ impl TimeStep {
             None if dt_stable.is_finite() => time.courant.unwrap_or(DEFAULT_COURANT) * dt_stable,
             None => return Err(ModelError::Invalid("no element has mass, so none sets a stable step: give `time.dt` [s]".into())),
         };
+        let steps = time.duration / dt;
+        if !(steps <= time.max_steps as f64) {
+            return Err(ModelError::Invalid(format!(
+                "time.duration {} s at dt {dt:.4e} s is {steps:.3e} steps, above time.max_steps = {} (stable step {dt_stable:.4e} s, set by element {} in \"{}\"). Shorten the duration, coarsen the critical element, or raise time.max_steps to allow it.",
+                time.duration, time.max_steps, model.critical.tag, model.critical.group
+            )));
+        }
         Ok(TimeStep { dt, dt_stable, dt_elements, penalty_omega2 })
     }
 
-    /// A note for the summary when penalty springs lowered the stable step.
+    /// A note for the summary when added stiffness (penalty springs, the condensed foundation's
+    /// interface bound) lowered the stable step.
     pub fn note(&self) -> Option<String> {
-        (self.penalty_omega2 > 0.0).then(|| format!("penalty springs: stable step reduced from {:.4e} s", self.dt_elements))
+        (self.penalty_omega2 > 0.0).then(|| format!("added stiffness (penalty springs, massless-foundation interface): stable step reduced from {:.4e} s to {:.4e} s", self.dt_elements, self.dt_stable))
     }
 
     /// Steps of a stage of `duration` [s]: duration / dt, rounded.

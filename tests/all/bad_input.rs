@@ -543,3 +543,18 @@ fn a_scene_file_name_with_spaces_gives_a_clean_default_name() {
     std::fs::write(&p, column_scene().to_string()).unwrap();
     assert_eq!(Scene::load(&p).unwrap().name(), "my_scene");
 }
+
+#[test]
+fn a_run_of_more_steps_than_max_steps_is_refused_up_front() {
+    // Before: dt 1e-300 or a duration of 1e300 s ran for ever with no output.
+    let mut s = column_scene();
+    s["time"] = json!({"duration": 1e300});
+    assert_mentions(&run_error("duration_huge", &s), &["time.duration", "steps, above time.max_steps = 100000000", "raise time.max_steps"]);
+    let mut s = column_scene();
+    s["time"] = json!({"duration": 1.0, "dt": 1e-300});
+    assert_mentions(&run_error("dt_tiny", &s), &["steps, above time.max_steps"]);
+    // The limit is a knob: a small one refuses the ordinary run, naming it.
+    let mut s = column_scene();
+    s["time"]["max_steps"] = json!(1);
+    assert_mentions(&run_error("max_steps_1", &s), &["above time.max_steps = 1 "]);
+}
