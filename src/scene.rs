@@ -158,19 +158,136 @@ fn down() -> [f64; 3] {
     [0.0, 0.0, -1.0]
 }
 
+/// One component of the base motion: a record file or a generated (synthetic) record, a
+/// direction, a scale and an explicit baseline correction (docs/scenes.md, docs/motion.md).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaseRecord {
-    /// Two-column text (t [s], a [g], `#` comments) or a PEER `.AT2` file.
-    pub record: PathBuf,
+    /// Two-column text (t [s], a [g], `#` comments) or a PEER `.AT2` file. Exclusive with `synth`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub record: Option<PathBuf>,
+    /// A spectrum-compatible record generated in memory (the same code as `record synth`,
+    /// deterministic per seed). Exclusive with `record`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub synth: Option<BaseSynth>,
     /// Direction of the ground acceleration (normalised on load).
     pub direction: [f64; 3],
     /// Multiplier on the record. Default 1. Exclusive with `pga`.
     #[serde(default)]
     pub scale: Option<f64>,
-    /// Target peak ground acceleration [g]: the record is scaled so that max |a| = pga.
+    /// Target peak ground acceleration [g]: the record is scaled so that max |a| = pga (after
+    /// the baseline correction, so the applied PGA is this one).
     #[serde(default)]
     pub pga: Option<f64>,
+    /// Baseline correction applied before scaling: "none" (default: the record as given),
+    /// "mean", "polynomial" (degree 5), {"highpass": corner_hz} (order 4, or "order"), or the
+    /// `record correct` form {"method": …}. Never applied unless asked; the drift left is a note.
+    #[serde(default)]
+    pub baseline: BaseCorrection,
+}
+
+impl BaseRecord {
+    /// Apply `f` to every file path of the entry (the record, a spectrum table or UHS file).
+    pub fn map_paths(&mut self, f: impl Fn(&mut PathBuf)) {
+        if let Some(r) = self.record.as_mut() {
+            f(r);
+        }
+        if let Some(s) = self.synth.as_mut() {
+            use crate::motion::TargetSpec;
+            if let TargetSpec::Table { file: Some(p), .. } | TargetSpec::Uhs { file: Some(p), .. } = &mut s.spectrum {
+                f(p);
+            }
+        }
+    }
+
+    /// How errors and notes name entry `k`: `loads.base[k] (record FILE)` or `(synth seed N h1)`.
+    pub fn label(&self, k: usize) -> String {
+        match (&self.record, &self.synth) {
+            (Some(r), _) => format!("loads.base[{k}] (record {})", r.display()),
+            (None, Some(s)) => format!("loads.base[{k}] (synth seed {} {})", s.seed, s.component),
+            (None, None) => format!("loads.base[{k}]"),
+        }
+    }
+}
+
+/// A generated base record: one component of the set `jointquake record synth` makes from a
+/// target spectrum and a seed (`--components 3`, so `h1`, `h2`, `v` are the components of
+/// that command's files, byte for byte before scaling).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaseSynth {
+    /// Target spectrum, the options of `record synth` (`{"kind": "code", "structure": "arch",
+    /// "site_class": "I"}`, `{"kind": "table", "points": [[T, Sa], …]}` or `"file"`, `"uhs"`).
+    pub spectrum: crate::motion::TargetSpec,
+    /// Seed of the random phases (ChaCha8): the same seed gives the same record.
+    pub seed: u64,
+    /// "h1", "h2" (horizontal) or "v" (vertical, 2/3 of the target and PGA). Default "h1".
+    #[serde(default = "default_component")]
+    pub component: String,
+    /// Record length [s]. Default 20 (the default envelope's 2 + 8 + 10 s).
+    #[serde(default = "default_synth_duration")]
+    pub duration: f64,
+    /// Sample interval [s]. Default 0.01 (100 Hz, as `record synth`).
+    #[serde(default = "default_synth_dt")]
+    pub dt: f64,
+    /// Horizontal design PGA of the set [g] (the code spectrum is a_h β(T)). Default: the
+    /// entry's `pga` (divided by the vertical ratio 2/3 for "v"), so the generated component
+    /// already has the requested peak.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pga: Option<f64>,
+}
+
+fn default_component() -> String {
+    "h1".into()
+}
+fn default_synth_duration() -> f64 {
+    20.0
+}
+fn default_synth_dt() -> f64 {
+    0.01
+}
+
+/// The `baseline` of a base entry (see [`BaseRecord::baseline`]).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum BaseCorrection {
+    /// "none", "mean" or "polynomial".
+    Named(String),
+    /// {"highpass": corner [Hz], "order": n (default 4)}.
+    HighPass(HighPassCorner),
+    /// The full form of `record correct`: {"method": "polynomial", "degree": 7}, ….
+    Method(crate::motion::Baseline),
+}
+
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct HighPassCorner {
+    pub highpass: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<u32>,
+}
+
+impl Default for BaseCorrection {
+    fn default() -> Self {
+        BaseCorrection::Named("none".into())
+    }
+}
+
+impl BaseCorrection {
+    /// The correction to apply (`None`: the record as given), or what to write instead.
+    pub fn resolve(&self) -> Result<Option<crate::motion::Baseline>, String> {
+        use crate::motion::Baseline;
+        match self {
+            BaseCorrection::Named(n) => match n.as_str() {
+                "none" => Ok(None),
+                "mean" => Ok(Some(Baseline::Mean)),
+                "polynomial" => Ok(Some(Baseline::Polynomial { degree: 5 })),
+                other => Err(format!("baseline = \"{other}\" is not a correction: give \"none\", \"mean\", \"polynomial\" or {{\"highpass\": corner_hz}}")),
+            },
+            BaseCorrection::HighPass(h) => Ok(Some(Baseline::HighPass { corner: h.highpass, order: h.order.unwrap_or(4) })),
+            BaseCorrection::Method(b) => Ok(Some(b.clone())),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -606,7 +723,7 @@ impl Scene {
             resolve(m);
         }
         for b in &mut scene.loads.base {
-            resolve(&mut b.record);
+            b.map_paths(&resolve);
         }
         if scene.name.is_none() {
             // From the file name, with the characters a name may not hold replaced by `_`.
@@ -678,22 +795,37 @@ impl Scene {
         if self.loads.base.len() > 3 {
             return Err(format!("loads.base: {} records given, at most 3", self.loads.base.len()));
         }
-        for b in &self.loads.base {
+        for (k, b) in self.loads.base.iter().enumerate() {
+            let l = b.label(k);
+            match (&b.record, &b.synth) {
+                (Some(_), Some(_)) => return Err(format!("{l}: give `record` (a file) or `synth` (a generated record), not both")),
+                (None, None) => return Err(format!("{l}: give `record` (a two-column or .AT2 file) or `synth` (a target spectrum and a seed)")),
+                _ => {}
+            }
+            if let Some(s) = &b.synth {
+                if !crate::motion::synth::COMPONENT_NAMES.contains(&s.component.as_str()) {
+                    return Err(format!("{l}: synth.component = \"{}\" must be \"h1\", \"h2\" or \"v\"", s.component));
+                }
+                if s.pga.is_none() && b.pga.is_none() {
+                    return Err(format!("{l}: a synth entry needs the set's design PGA: give the entry's `pga` [g] (or `synth.pga`, the horizontal PGA the spectrum is drawn for, with `scale`)"));
+                }
+            }
+            b.baseline.resolve().map_err(|e| format!("{l}: {e}"))?;
             if b.scale.is_some() && b.pga.is_some() {
-                return Err(format!("loads.base {}: give `scale` or `pga`, not both", b.record.display()));
+                return Err(format!("{l}: give `scale` or `pga`, not both"));
             }
             let n = (b.direction[0].powi(2) + b.direction[1].powi(2) + b.direction[2].powi(2)).sqrt();
             if !(n > 0.0 && n.is_finite()) {
-                return Err(format!("loads.base {}: direction must be a non-zero vector", b.record.display()));
+                return Err(format!("{l}: direction must be a non-zero vector"));
             }
             if let Some(pga) = b.pga {
                 if !(pga > 0.0 && pga.is_finite()) {
-                    return Err(format!("loads.base {}: pga = {pga} must be positive [g]. To reverse the record's polarity, reverse its `direction`.", b.record.display()));
+                    return Err(format!("{l}: pga = {pga} must be positive [g]. To reverse the record's polarity, reverse its `direction`."));
                 }
             }
             if let Some(sc) = b.scale {
                 if !(sc > 0.0 && sc.is_finite()) {
-                    return Err(format!("loads.base {}: scale = {sc} must be positive. To reverse the record's polarity, reverse its `direction`.", b.record.display()));
+                    return Err(format!("{l}: scale = {sc} must be positive. To reverse the record's polarity, reverse its `direction`."));
                 }
             }
         }

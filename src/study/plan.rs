@@ -106,7 +106,7 @@ pub fn load_base(study: &Study) -> Result<Scene, Error> {
         *m = absolute(m);
     }
     for b in &mut s.loads.base {
-        b.record = absolute(&b.record);
+        b.map_paths(|p| *p = absolute(p));
     }
     Ok(s)
 }
@@ -198,13 +198,16 @@ fn pga_factor(scene: &Scene, pga: f64) -> Result<f64, Error> {
 /// become one `scale` each.
 fn apply_pga(s: &mut Scene, pga: f64) -> Result<(), Error> {
     let f = pga_factor(s, pga)?;
-    for b in &mut s.loads.base {
-        let own = match (b.scale, b.pga) {
-            (_, Some(p)) => p * s.g / crate::dynamics::record::Record::read(&b.record, s.g)?.peak(),
-            (Some(sc), None) => sc,
-            (None, None) => 1.0,
-        };
-        b.scale = Some(own * f);
+    let (motions, _) = base_motions(s)?;
+    for (b, m) in s.loads.base.iter_mut().zip(&motions) {
+        // a synth entry keeps the design PGA its spectrum was drawn for
+        if let Some(sy) = b.synth.as_mut()
+            && sy.pga.is_none()
+        {
+            let ratio = crate::motion::SynthRequest::new(sy.spectrum.clone(), 1.0, sy.seed).vertical_ratio;
+            sy.pga = b.pga.map(|p| if sy.component == "v" { p / ratio } else { p });
+        }
+        b.scale = Some(m.scale * f);
         b.pga = None;
     }
     Ok(())

@@ -13,6 +13,7 @@ mod dynamics;
 mod fuzz;
 mod mesh;
 mod motion;
+mod motion_scene;
 mod outputs;
 mod report;
 mod rigid;
