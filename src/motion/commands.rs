@@ -1,5 +1,5 @@
 //! The `jointquake record info|correct|synth|match` stages as library calls: they take arrays
-//! (the CLI reads the record with [`crate::dynamics::record::Record::read`]), write files and
+//! (the CLI reads the record with `dynamics::record::Record::read`), write files and
 //! charts, and return the one-screen text the CLI prints.
 
 use super::baseline::{Baseline, correct, drift};

@@ -1,5 +1,5 @@
 //! Two-column record files (t [s], a [g]) with a `#` header; the reader is
-//! [`crate::dynamics::record::Record::read`], which reads what this writes.
+//! `dynamics::record::Record::read`, which reads what this writes.
 //!
 //! Values are written with ten significant digits so that the file's PGA is the requested one
 //! to 1e-10 and a seed always gives the same bytes.

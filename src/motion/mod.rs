@@ -10,7 +10,7 @@
 //! Conventions, written once here:
 //! - acceleration in m/s² inside the library, g only in files and target spectra (Sa in g);
 //! - the input between samples is linear (the Nigam–Jennings and the integration reading of a
-//!   record; [`crate::dynamics::record::Record::at`] interpolates the same way) and zero after
+//!   record; `dynamics::record::Record::at` interpolates the same way) and zero after
 //!   the last sample;
 //! - integration starts at rest (v = d = 0 at the first sample);
 //! - spectra are 5 %-damped pseudo-accelerations PSA = ω² max|u| unless a damping is given;
