@@ -277,12 +277,12 @@ struct TargetArgs {
 
 #[derive(clap::Args)]
 struct FitArgs {
-    /// Relative tolerance of the spectral match.
+    /// Largest relative shortfall below the target at any check period (SRP 3.7.1: 0.10).
     #[arg(long, default_value_t = 0.10)]
     tolerance: f64,
-    /// Check band [s] as LO,HI.
-    #[arg(long, default_value = "0.1,3.0")]
-    band: String,
+    /// Check band [s] as LO,HI. Default 0.04,3.0 (match: the lower end at least 4 dt).
+    #[arg(long)]
+    band: Option<String>,
     #[arg(long, default_value_t = 100)]
     max_iterations: usize,
     /// Baseline correction of every iterate: mean | polynomial | highpass.
@@ -540,7 +540,9 @@ fn record_cmd(action: RecordCmd) -> Result<()> {
             e.decay = decay.unwrap_or(e.decay);
             e.end_level = end_level.unwrap_or(e.end_level);
             req.tolerance = fit.tolerance;
-            req.band = band_of(&fit.band)?;
+            if let Some(b) = &fit.band {
+                req.band = band_of(b)?;
+            }
             req.max_iterations = fit.max_iterations;
             req.baseline = baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)?;
             let (text, _) = commands::synth_files(&req, &out, &name).context("synthesising the set")?;
@@ -549,7 +551,11 @@ fn record_cmd(action: RecordCmd) -> Result<()> {
         RecordCmd::Match { file, target, pga, fit, out, g } => {
             let r = Record::read(&file, g).with_context(|| format!("reading record {}", file.display()))?;
             let t = target_of(&target)?.resolve(pga, "spectrum").context("the target spectrum")?;
-            let opts = synth::MatchOptions { tolerance: fit.tolerance, band: band_of(&fit.band)?, max_iterations: fit.max_iterations, baseline: baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)? };
+            let band = match &fit.band {
+                Some(b) => band_of(b)?,
+                None => [f64::max(0.04, 4.0 * r.dt), 3.0],
+            };
+            let opts = synth::MatchOptions { tolerance: fit.tolerance, band, max_iterations: fit.max_iterations, baseline: baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)? };
             let ag: Vec<f64> = r.accel.iter().map(|a| a / g).collect();
             let text = commands::match_file(&file, r.dt, &ag, &t, pga, &opts, &out).with_context(|| format!("matching {}", file.display()))?;
             say_raw!("{text}");

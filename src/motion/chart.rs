@@ -23,14 +23,14 @@ pub fn write_history_charts(stem: &Path, title: &str, t0: f64, dt: f64, accel_g:
 }
 
 /// `<stem>` (.png + .svg): spectra (name, PSA [g]) on `periods` [s], with an optional target
-/// and its ± tolerance lines.
-pub fn write_spectrum_chart(stem: &Path, title: &str, periods: &[f64], spectra: &[(String, Vec<f64>)], target: Option<(&str, &[f64], f64)>) -> Result<PathBuf, MotionError> {
+/// and its acceptance lines target × (1 − lower) and target × (1 + upper).
+pub fn write_spectrum_chart(stem: &Path, title: &str, periods: &[f64], spectra: &[(String, Vec<f64>)], target: Option<(&str, &[f64], [f64; 2])>) -> Result<PathBuf, MotionError> {
     let mut series = Vec::new();
-    if let Some((label, sa, tol)) = target {
+    if let Some((label, sa, [lower, upper])) = target {
         series.push(Series::line(format!("target: {label}"), periods.iter().copied().zip(sa.iter().copied())));
-        if tol > 0.0 {
-            series.push(Series::line(format!("target × (1 ± {tol})"), periods.iter().copied().zip(sa.iter().map(|s| s * (1.0 + tol)))));
-            series.push(Series::line("", periods.iter().copied().zip(sa.iter().map(|s| s * (1.0 - tol)))));
+        if lower > 0.0 || upper > 0.0 {
+            series.push(Series::line(format!("target × {:.2} and × {:.2} (acceptance)", 1.0 - lower, 1.0 + upper), periods.iter().copied().zip(sa.iter().map(|s| s * (1.0 + upper)))));
+            series.push(Series::line("", periods.iter().copied().zip(sa.iter().map(|s| s * (1.0 - lower)))));
         }
     }
     for (name, sa) in spectra {

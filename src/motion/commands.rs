@@ -7,7 +7,7 @@ use super::chart::{write_history_charts, write_spectrum_chart};
 use super::io::write_two_column;
 use super::measures::intensity_measures;
 use super::spectrum::{default_periods, response_spectrum};
-use super::synth::{MatchOptions, SynthRequest, match_record, synthesize_set};
+use super::synth::{MatchOptions, SynthRequest, UPPER_LIMIT, match_record, synthesize_set};
 use super::target::TargetSpectrum;
 use super::MotionError;
 use std::fmt::Write as _;
@@ -95,7 +95,7 @@ pub fn synth_files(req: &SynthRequest, out: &Path, name: &str) -> Result<(String
         let psa = response_spectrum(&c.accel_g, c.dt, &periods, 0.05);
         let tgt: Vec<f64> = periods.iter().map(|&p| c.target.sa(p)).collect();
         let stem = out.join(format!("{name}_s{}_{}_spectrum", req.seed, c.name));
-        write_spectrum_chart(&stem, &format!("{name} seed {} {}: target and achieved", req.seed, c.name), &periods, &[(format!("{} (achieved)", c.name), psa)], Some((&c.target.label, &tgt, req.tolerance)))?;
+        write_spectrum_chart(&stem, &format!("{name} seed {} {}: target and achieved", req.seed, c.name), &periods, &[(format!("{} (achieved)", c.name), psa)], Some((&c.target.label, &tgt, [req.tolerance, UPPER_LIMIT])))?;
         let _ = writeln!(t, "  {} PGA {:.6} g: {}", c.name, c.pga_g, c.check.describe());
         let _ = writeln!(t, "     {}", c.drift.describe());
         let _ = writeln!(t, "     {} ; chart {}.png (and .svg)", f.display(), stem.display());
@@ -118,6 +118,6 @@ pub fn match_file(source: &Path, dt: f64, accel_g: &[f64], target: &TargetSpectr
     let after = response_spectrum(&c.accel_g, dt, &periods, 0.05);
     let tgt: Vec<f64> = periods.iter().map(|&p| target.sa(p)).collect();
     let stem = out_file.with_extension("").with_file_name(format!("{}_spectrum", out_file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()));
-    write_spectrum_chart(&stem, "matched record: target, original (PGA-scaled) and matched", &periods, &[("original, PGA-scaled".into(), before), ("matched".into(), after)], Some((&target.label, &tgt, opts.tolerance)))?;
+    write_spectrum_chart(&stem, "matched record: target, original (PGA-scaled) and matched", &periods, &[("original, PGA-scaled".into(), before), ("matched".into(), after)], Some((&target.label, &tgt, [opts.tolerance, UPPER_LIMIT])))?;
     Ok(format!("{}\n  {}\n  {}\n  written {} ; chart {}.png (and .svg)\n", c.header[0], c.check.describe(), c.drift.describe(), out_file.display(), stem.display()))
 }

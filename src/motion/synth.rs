@@ -7,24 +7,38 @@
 //! independent sequence, and a seed always gives the same record), multiplied by the intensity
 //! envelope ([`Envelope`]), baseline-corrected ([`super::baseline`], default polynomial degree 5
 //! with zero end velocity and displacement) and scaled so that its PGA is the requested one.
-//! The amplitudes are then corrected in the frequency domain, A_k ← A_k · Sa_target/Sa(f_k)
-//! (the ratio interpolated in log T between the iteration periods, held constant outside), and
-//! the record rebuilt with the same phases, until the 5 % PSA is within the tolerance of the
-//! target at every check period ([`MatchCheck`]). Every iterate is corrected and scaled, so the
-//! record that passes the check is the record written.
+//! The amplitudes are then corrected in the frequency domain, A_k ← A_k · (1.08 Sa_target /
+//! Sa(f_k))^0.5 (the log-ratio averaged over neighbouring periods, interpolated in log T between
+//! the iteration periods, held constant outside), and the record rebuilt with the same phases,
+//! until the 5 % PSA passes the acceptance rule below ([`MatchCheck`]). Every iterate is
+//! corrected and scaled, so the record that passes the check is the record written.
 //!
 //! **Matching a real record**: the same iteration starting from the record's own Fourier
 //! transform (its phases, and so its time structure, are kept; no envelope is applied).
 //!
-//! Acceptance (stated, not taken from a code clause): the 5 %-damped PSA at the 60 log-spaced
-//! check periods of `band` (default 0.1–3 s, the codes' drawn range above the rising branch) is
-//! within ±`tolerance` (default 10 %) of the target at all but [`OUTSIDE_SHARE`] (10 %, 6 of 60)
-//! of them, and within ±1.5 × tolerance (15 %) at every one. Frequency-domain scaling alone
-//! stalls at about ±11–15 % at a few periods (the envelope couples neighbouring frequencies);
-//! a time-domain wavelet adjustment would be the next step to tighten it.
-//! A set that does not pass after `max_iterations` is an error ([`MotionError::NotMatched`])
-//! quoting the worst period. Components of a set must have pairwise correlation coefficients
-//! |ρ| < 0.3 (random phases give about 0.05); otherwise the set is refused (try another seed).
+//! **Acceptance rule** (the one place it is written; [`MatchCheck::passed`]): USNRC Standard
+//! Review Plan (NUREG-0800) §3.7.1 Rev. 3 (2007), Acceptance Criteria, Option 1 Approach 2
+//! (a single artificial time history; quoted from memory of the public NRC text, which the
+//! search tools here did not hold; ASCE 4-16 §2.3 has a related rule, not checked): the 5 %-damped
+//! spectrum is computed at [`POINTS_PER_DECADE`] (100) log-spaced periods per decade over the
+//! check band (default 0.04–3 s: SRP compares 0.2–25 Hz; the DL 5073-2000 spectrum is drawn to
+//! 3 s and 25 Hz is a quarter of the 100 Hz sampling), and
+//! - no point lies more than `tolerance` (default 10 %) below the target;
+//! - at most [`MAX_RUN_BELOW`] (9) adjacent points lie below the target;
+//! - no point lies more than [`UPPER_LIMIT`] (30 %) above the target. SRP asks for a power
+//!   spectral density check only when a record exceeds 1.3 × target; here such a record is
+//!   refused instead (stricter, and no PSD check is needed).
+//!
+//! Why this clause: the Chinese hydraulic codes (DL 5073-2000, NB 35047-2015, GB 51247-2018)
+//! ask for artificial accelerograms compatible with the design spectrum, but the texts we
+//! could search give no numeric tolerance for it (docs/motion.md); SRP 3.7.1 is the most widely
+//! used numeric per-record rule. Eurocode 8 (EN 1998-1 §3.2.3.1.2(4)) judges a suite of at least
+//! three records by its mean (mean 5 % spectrum ≥ 90 % of the target on 0.2 T1–2 T1, mean
+//! zero-period value ≥ a_g S): every record passing SRP is ≥ 90 % of the target at every check
+//! period and at the PGA exactly, so any suite of them passes EC8 as well.
+//! A record that does not pass after `max_iterations` is an error ([`MotionError::NotMatched`])
+//! quoting the lowest and highest ratios. Components of a set must have pairwise correlation
+//! coefficients |ρ| < 0.3 (random phases give about 0.05); otherwise the set is refused.
 
 use super::baseline::{Baseline, Drift, correct, drift};
 use super::spectrum::response_spectrum;
@@ -134,13 +148,14 @@ pub struct SynthRequest {
     pub vertical_ratio: f64,
     #[serde(default)]
     pub envelope: Envelope,
-    /// Relative tolerance of the spectral match. Default 0.10.
+    /// Largest shortfall of the 5 % PSA below the target at any check period, relative.
+    /// Default 0.10 (SRP 3.7.1: not more than 10 % below at any one frequency).
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
-    /// Check band [s]. Default [0.1, 3.0].
+    /// Check band [s]. Default [0.04, 3.0] (25 Hz to the end of the code's drawn spectrum).
     #[serde(default = "default_band")]
     pub band: [f64; 2],
-    /// Iteration limit. Default 40.
+    /// Iteration limit of each attempt (phase stream). Default 100.
     #[serde(default = "default_iterations")]
     pub max_iterations: usize,
     /// Baseline correction applied to each iterate. Default polynomial, degree 5.
@@ -164,7 +179,7 @@ fn default_tolerance() -> f64 {
     0.10
 }
 fn default_band() -> [f64; 2] {
-    [0.1, 3.0]
+    [0.04, 3.0]
 }
 fn default_iterations() -> usize {
     100
@@ -173,18 +188,37 @@ fn default_baseline() -> Baseline {
     Baseline::Polynomial { degree: 5 }
 }
 
-/// Half-width (in check periods) of the log-ratio smoothing of each correction.
-const SMOOTH: usize = 1;
+/// Half-width of the log-ratio smoothing of each correction, in check-period steps:
+/// SMOOTH_PER_SECOND × T, at least SMOOTH_MIN and at most SMOOTH_MAX (2 steps = ±4.7 % in
+/// period at short periods; at 3 s, ±7.5 steps = ±19 %, about the 1/(8 s strong part) spread of
+/// the envelope at 0.33 Hz).
+const SMOOTH_PER_SECOND: f64 = 2.5;
+const SMOOTH_MIN: f64 = 2.0;
+const SMOOTH_MAX: f64 = 12.0;
+/// Headroom to the acceptance limits sought after the first accepted iterate, and the most
+/// iterations spent seeking it.
+const HEADROOM: f64 = 0.02;
+const EXTRA_ITERATIONS: usize = 6;
+/// Iterations without a better iterate after which an attempt is abandoned.
+const STALL: usize = 30;
+/// Phase streams tried per component: attempt k of component c draws its phases from stream
+/// c + 3 k of the seed (deterministic; the header names the stream).
+const ATTEMPTS: u64 = 4;
 /// Exponent of each correction (under-relaxation: 0.5 converged on every seed tried where 1
-/// oscillated at ±11–17 %).
+/// oscillated).
 const RELAXATION: f64 = 0.5;
-/// Share of the check periods that may lie outside ±tolerance (none beyond 1.5 × tolerance).
-pub const OUTSIDE_SHARE: f64 = 0.10;
+/// The iteration aims at AIM × target: the acceptance band is lopsided (−10 % … +30 %, runs
+/// below the target limited), so the aim sits a little above the target.
+const AIM: f64 = 1.08;
 
 /// Damping ratio of the spectra matched and checked.
 pub const DAMPING: f64 = 0.05;
-/// Check and iteration periods in the band.
-pub const CHECK_POINTS: usize = 60;
+/// Check periods per decade (SRP 3.7.1: at least 100 points per frequency decade).
+pub const POINTS_PER_DECADE: f64 = 100.0;
+/// Largest excess above the target at any check period, relative (SRP 3.7.1: 30 %).
+pub const UPPER_LIMIT: f64 = 0.30;
+/// Most adjacent check periods allowed below the target (SRP 3.7.1: nine).
+pub const MAX_RUN_BELOW: usize = 9;
 /// Largest accepted |correlation coefficient| between two components of a set.
 pub const MAX_CORRELATION: f64 = 0.3;
 
@@ -230,7 +264,7 @@ impl SynthRequest {
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
             return Err(MotionError::invalid(f("tolerance"), format!("{} must be in (0, 1)", self.tolerance)));
         }
-        let [lo, hi] = self.band;
+        let [lo, hi] = self.check_band();
         if !(lo > 0.0 && hi > lo) {
             return Err(MotionError::invalid(f("band"), format!("[{lo}, {hi}] s must be increasing and positive")));
         }
@@ -247,6 +281,13 @@ impl SynthRequest {
             MotionError::Invalid { field: fl, message } => MotionError::Invalid { field: f(&fl), message },
             other => other,
         })
+    }
+
+    /// The band checked: `band`, except that the default band starts at 4 dt when 4 dt exceeds its
+    /// 0.04 s (a coarser sampling cannot carry 25 Hz; the band used is in every header).
+    pub fn check_band(&self) -> [f64; 2] {
+        let d = default_band();
+        if self.band == d { [d[0].max(4.0 * self.dt), d[1]] } else { self.band }
     }
 
     /// The `jointquake record synth` command that makes this set.
@@ -296,40 +337,67 @@ impl SynthRequest {
     }
 }
 
-/// How well a record's 5 % PSA matches its target on the check periods.
+/// How well a record's 5 % PSA matches its target on the check periods (the acceptance rule
+/// of the module doc: SRP 3.7.1 Option 1 Approach 2).
 #[derive(Clone, Debug, Serialize)]
 pub struct MatchCheck {
     pub band: [f64; 2],
     pub tolerance: f64,
+    /// Check periods in the band (log-spaced, ends included) and their number per decade
+    /// ([`POINTS_PER_DECADE`] for an accepted record; half that on the iterations' coarse grid).
     pub points: usize,
-    /// Points with |Sa/Sa_target − 1| > tolerance.
-    pub outside: usize,
+    pub per_decade: f64,
+    /// Points with Sa < (1 − tolerance) Sa_target.
+    pub below_tolerance: usize,
+    /// Most adjacent points with Sa < Sa_target.
+    pub longest_run_below: usize,
+    /// Points with Sa > (1 + [`UPPER_LIMIT`]) Sa_target.
+    pub above_upper: usize,
     /// Largest and smallest Sa/Sa_target − 1.
     pub max_ratio_error: f64,
     pub min_ratio_error: f64,
-    /// Period [s] of the largest |Sa/Sa_target − 1|.
-    pub worst_period: f64,
+    /// Periods [s] of the smallest and of the largest Sa/Sa_target.
+    pub lowest_period: f64,
+    pub highest_period: f64,
     pub iterations: usize,
 }
 
 impl MatchCheck {
-    /// At most [`OUTSIDE_SHARE`] of the points outside ±tolerance, none beyond 1.5 × tolerance.
+    /// No point more than `tolerance` below the target, at most [`MAX_RUN_BELOW`] adjacent points
+    /// below it, no point more than [`UPPER_LIMIT`] above it.
     pub fn passed(&self) -> bool {
-        self.outside as f64 <= OUTSIDE_SHARE * self.points as f64 && self.max_ratio_error <= 1.5 * self.tolerance && -self.min_ratio_error <= 1.5 * self.tolerance
+        self.below_tolerance == 0 && self.longest_run_below <= MAX_RUN_BELOW && self.above_upper == 0
+    }
+    /// How far the check is from passing (0 when it passes): the shortfall below 1 − tolerance,
+    /// the excess above 1 + UPPER_LIMIT, and 0.2 % per point of a run below the target beyond
+    /// MAX_RUN_BELOW.
+    fn violation(&self) -> f64 {
+        (-self.tolerance - self.min_ratio_error).max(0.0) + (self.max_ratio_error - UPPER_LIMIT).max(0.0) + 0.002 * self.longest_run_below.saturating_sub(MAX_RUN_BELOW) as f64
+    }
+    /// Lower is better: the violation when the check fails, else minus the headroom (the smaller
+    /// of the distances of the lowest ratio to 1 − tolerance and of the highest to 1 + UPPER_LIMIT).
+    fn score(&self) -> f64 {
+        if self.passed() { -(self.min_ratio_error + self.tolerance).min(UPPER_LIMIT - self.max_ratio_error) } else { self.violation() }
     }
     pub fn describe(&self) -> String {
         format!(
-            "5 % PSA / target − 1 over {}–{} s ({} periods): {:+.1} % … {:+.1} % ({} outside ±{:.0} %; accepted: ≤ {:.0} % of the periods outside, none beyond ±{:.0} %), worst at {:.3} s, {} iterations",
+            "5 % PSA / target − 1 over {}–{} s ({} periods, {} per decade): {:+.1} % (at {:.3} s) … {:+.1} % (at {:.3} s); longest run below the target {} periods; {} below −{:.0} %, {} above +{:.0} % (accepted, USNRC SRP 3.7.1 Rev. 3 Option 1 Approach 2: none below −{:.0} %, none above +{:.0} %, at most {} adjacent below); {} iterations",
             self.band[0],
             self.band[1],
             self.points,
+            self.per_decade,
             100.0 * self.min_ratio_error,
+            self.lowest_period,
             100.0 * self.max_ratio_error,
-            self.outside,
+            self.highest_period,
+            self.longest_run_below,
+            self.below_tolerance,
             100.0 * self.tolerance,
-            100.0 * OUTSIDE_SHARE,
-            150.0 * self.tolerance,
-            self.worst_period,
+            self.above_upper,
+            100.0 * UPPER_LIMIT,
+            100.0 * self.tolerance,
+            100.0 * UPPER_LIMIT,
+            MAX_RUN_BELOW,
             self.iterations
         )
     }
@@ -383,6 +451,11 @@ struct Iterate {
 
 impl Iteration<'_> {
     /// Iterate from the spectrum `base` (length nfft, Hermitian) with an optional envelope.
+    ///
+    /// Each iterate's spectrum is computed on every other check period (half the cost); when that
+    /// passes, the other half is computed and the whole grid decides. After the first iterate
+    /// that passes on the whole grid, at most [`EXTRA_ITERATIONS`] more are run while the
+    /// headroom to the limits is below [`HEADROOM`]; the iterate with the largest headroom is kept.
     fn run(&self, base: &[Complex<f64>], envelope: Option<&[f64]>) -> Result<Iterate, MotionError> {
         let mut planner = FftPlannerScalar::<f64>::new();
         let inverse = planner.plan_fft_inverse(self.nfft);
@@ -391,7 +464,15 @@ impl Iteration<'_> {
         let mut mult = vec![1.0f64; half + 1];
         let mut buf = vec![Complex::new(0.0, 0.0); self.nfft];
         let mut best: Option<Iterate> = None;
-        let lt: Vec<f64> = self.periods.iter().map(|t| t.ln()).collect();
+        let step = std::f64::consts::LN_10 / POINTS_PER_DECADE;
+        // every other period, counted from the band's lower end, and the band's upper end
+        let i_lo = self.periods.iter().position(|&t| t >= self.band[0] * (1.0 - 1e-9)).unwrap_or(0);
+        let i_hi = self.periods.iter().rposition(|&t| t <= self.band[1] * (1.0 + 1e-9)).unwrap_or(self.periods.len() - 1);
+        let coarse: Vec<usize> = (0..self.periods.len()).filter(|&i| (i + i_lo) % 2 == 0 || i == i_hi).collect();
+        let other: Vec<usize> = (0..self.periods.len()).filter(|i| !coarse.contains(i)).collect();
+        let pick = |v: &[f64], idx: &[usize]| idx.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+        let (pc, tc) = (pick(&self.periods, &coarse), pick(&self.target, &coarse));
+        let mut first_pass: Option<usize> = None;
         for it in 1..=self.max_iterations {
             for k in 0..self.nfft {
                 let kk = k.min(self.nfft - k);
@@ -422,31 +503,51 @@ impl Iteration<'_> {
             scale_to_pga(&mut c, self.pga);
             let c_si: Vec<f64> = c.iter().map(|x| x * g).collect();
             let dr = drift(&c_si, self.dt);
-            let sa = response_spectrum(&c, self.dt, &self.periods, DAMPING);
-            // the ratio smoothed over 3 neighbouring periods in log and applied with the exponent
-            // RELAXATION: the envelope spreads each frequency over about 1/(strong duration),
-            // wider than the period spacing at long periods, where raw corrections of
-            // neighbouring periods fight each other and the iteration oscillates
-            let raw: Vec<f64> = sa.iter().zip(&self.target).map(|(s, t)| (t / s.max(1e-300)).ln()).collect();
-            let ratio: Vec<f64> = (0..raw.len())
-                .map(|i| {
-                    let (a, b) = (i.saturating_sub(SMOOTH), (i + SMOOTH + 1).min(raw.len()));
-                    (raw[a..b].iter().sum::<f64>() / (b - a) as f64).exp()
-                })
-                .collect();
-            let check = self.check(&sa, it);
-            let better = best.as_ref().is_none_or(|b| {
-                let e = |m: &MatchCheck| m.max_ratio_error.max(-m.min_ratio_error);
-                e(&check) < e(&b.check)
-            });
-            let passed = check.passed();
-            if better || passed {
+            let sac = response_spectrum(&c, self.dt, &pc, DAMPING);
+            let coarse_check = self.check(&pc, &sac, &tc, POINTS_PER_DECADE / 2.0, it);
+            let (check, periods, sa, target) = if coarse_check.passed() {
+                let sao = response_spectrum(&c, self.dt, &pick(&self.periods, &other), DAMPING);
+                let mut sa = vec![0.0; self.periods.len()];
+                coarse.iter().zip(&sac).chain(other.iter().zip(&sao)).for_each(|(&i, &v)| sa[i] = v);
+                (self.check(&self.periods, &sa, &self.target, POINTS_PER_DECADE, it), self.periods.clone(), sa, self.target.clone())
+            } else {
+                (coarse_check, pc.clone(), sac, tc.clone())
+            };
+            if check.passed() && first_pass.is_none() {
+                first_pass = Some(it);
+            }
+            let better = best.as_ref().is_none_or(|b| check.score() < b.check.score());
+            if better {
                 best = Some(Iterate { accel_g: c, check, drift_uncorrected, drift: dr });
             }
-            if passed {
+            if let (Some(b), Some(p)) = (&best, first_pass)
+                && (-b.check.score() >= HEADROOM || it >= p + EXTRA_ITERATIONS)
+            {
                 break;
             }
-            // amplitude correction at each FFT frequency: ratio interpolated in log T
+            if first_pass.is_none() && best.as_ref().is_some_and(|b| it >= b.check.iterations + STALL) {
+                break;
+            }
+            // correction AIM × target / achieved, its logarithm averaged over ±SMOOTH_STEPS(T)
+            // fine-grid steps in log T (the envelope spreads each frequency over about
+            // 1/(strong duration), wider than the period spacing at long periods, where raw
+            // corrections of neighbouring periods fight each other), applied with the exponent
+            // RELAXATION and interpolated in log T at each FFT frequency
+            let lt: Vec<f64> = periods.iter().map(|t| t.ln()).collect();
+            let raw: Vec<f64> = sa.iter().zip(&target).map(|(s, t)| (AIM * t / s.max(1e-300)).ln()).collect();
+            let ratio: Vec<f64> = (0..raw.len())
+                .map(|i| {
+                    let w = step * (SMOOTH_PER_SECOND * periods[i]).clamp(SMOOTH_MIN, SMOOTH_MAX) + 1e-9;
+                    let (mut sum, mut cnt) = (0.0, 0.0);
+                    for j in 0..raw.len() {
+                        if (lt[j] - lt[i]).abs() <= w {
+                            sum += raw[j];
+                            cnt += 1.0;
+                        }
+                    }
+                    (sum / cnt).exp()
+                })
+                .collect();
             for (kk, m) in mult.iter_mut().enumerate().skip(1) {
                 let t = 1.0 / (kk as f64 * df);
                 *m *= interp_log(&lt, &ratio, t.ln()).powf(RELAXATION);
@@ -462,25 +563,47 @@ impl Iteration<'_> {
         Ok(b)
     }
 
-    fn check(&self, sa: &[f64], iterations: usize) -> MatchCheck {
-        let (mut outside, mut mx, mut mn, mut worst, mut wp, mut pts) = (0, f64::NEG_INFINITY, f64::INFINITY, 0.0f64, 0.0, 0);
-        for ((&t, &s), &g) in self.periods.iter().zip(sa).zip(&self.target) {
+    /// The acceptance check of `sa` against `target` at the `periods` of the band.
+    fn check(&self, periods: &[f64], sa: &[f64], target: &[f64], per_decade: f64, iterations: usize) -> MatchCheck {
+        let mut m = MatchCheck {
+            band: self.band,
+            tolerance: self.tolerance,
+            points: 0,
+            per_decade,
+            below_tolerance: 0,
+            longest_run_below: 0,
+            above_upper: 0,
+            max_ratio_error: f64::NEG_INFINITY,
+            min_ratio_error: f64::INFINITY,
+            lowest_period: 0.0,
+            highest_period: 0.0,
+            iterations,
+        };
+        let mut run = 0;
+        for ((&t, &s), &g) in periods.iter().zip(sa).zip(target) {
             if t < self.band[0] * (1.0 - 1e-9) || t > self.band[1] * (1.0 + 1e-9) {
                 continue;
             }
-            pts += 1;
+            m.points += 1;
             let e = s / g - 1.0;
-            if e.abs() > self.tolerance {
-                outside += 1;
+            if e < -self.tolerance {
+                m.below_tolerance += 1;
             }
-            mx = f64::max(mx, e);
-            mn = f64::min(mn, e);
-            if e.abs() > worst {
-                worst = e.abs();
-                wp = t;
+            if e > UPPER_LIMIT {
+                m.above_upper += 1;
+            }
+            run = if e < 0.0 { run + 1 } else { 0 };
+            m.longest_run_below = m.longest_run_below.max(run);
+            if e > m.max_ratio_error {
+                m.max_ratio_error = e;
+                m.highest_period = t;
+            }
+            if e < m.min_ratio_error {
+                m.min_ratio_error = e;
+                m.lowest_period = t;
             }
         }
-        MatchCheck { band: self.band, tolerance: self.tolerance, points: pts, outside, max_ratio_error: mx, min_ratio_error: mn, worst_period: wp, iterations }
+        m
     }
 }
 
@@ -561,14 +684,17 @@ fn interp_log(x: &[f64], y: &[f64], t: f64) -> f64 {
     y[i - 1] + f * (y[i] - y[i - 1])
 }
 
-/// Iteration periods: the check band on [`CHECK_POINTS`] log-spaced periods, extended at the same
-/// spacing a little beyond both ends (so the correction is not held flat right at the band's edge),
-/// but not below 4 dt.
+/// Iteration and check periods: the band on [`POINTS_PER_DECADE`] log-spaced periods per decade
+/// (both ends included), extended at the same spacing by six periods beyond both ends (so the
+/// correction is not held flat right at the band's edge), but not below 4 dt.
 fn iteration_periods(band: [f64; 2], dt: f64) -> Vec<f64> {
-    let step = (band[1] / band[0]).ln() / (CHECK_POINTS - 1) as f64;
+    let decades = (band[1] / band[0]).log10();
+    let intervals = ((POINTS_PER_DECADE * decades).ceil() as usize).max(1);
+    let step = (band[1] / band[0]).ln() / intervals as f64;
     let lo = (band[0].ln() - 6.0 * step).max((4.0 * dt).ln());
     let hi = band[1].ln() + 6.0 * step;
-    let mut p: Vec<f64> = (0..CHECK_POINTS).map(|i| (band[0].ln() + step * i as f64).exp()).collect();
+    let mut p: Vec<f64> = (0..=intervals).map(|i| (band[0].ln() + step * i as f64).exp()).collect();
+    p[intervals] = band[1];
     let mut k = 1;
     while band[0].ln() - step * k as f64 >= lo - 1e-12 {
         p.push((band[0].ln() - step * k as f64).exp());
@@ -618,10 +744,11 @@ pub fn synthesize_components(req: &SynthRequest, field: &str, which: &[usize]) -
     // enough bins to be corrected one by one
     let nfft = (2 * n).next_power_of_two();
     let df = 1.0 / (nfft as f64 * req.dt);
-    let periods = iteration_periods(req.band, req.dt);
+    let band = req.check_band();
+    let periods = iteration_periods(band, req.dt);
     let env: Vec<f64> = (0..n).map(|i| req.envelope.value(i as f64 * req.dt)).collect();
     // lowest frequency carried: half the band's lowest frequency, cosine taper below it
-    let f_lo = 1.0 / (2.0 * req.band[1]);
+    let f_lo = 1.0 / (2.0 * band[1]);
     let mut comps = Vec::new();
     for &c in which {
         if c >= req.components {
@@ -630,17 +757,6 @@ pub fn synthesize_components(req: &SynthRequest, field: &str, which: &[usize]) -
         let vertical = c == 2;
         let target = if vertical { horizontal.scaled(req.vertical_ratio) } else { horizontal.clone() };
         let pga = if vertical { req.pga * req.vertical_ratio } else { req.pga };
-        let mut rng = phase_stream(req.seed, c as u64);
-        let mut base = vec![Complex::new(0.0, 0.0); nfft];
-        for k in 1..nfft / 2 {
-            let f = k as f64 * df;
-            let phase = std::f64::consts::TAU * unit(&mut rng);
-            let taper = if f >= f_lo { 1.0 } else if f > 0.5 * f_lo { 0.5 * (1.0 - (std::f64::consts::PI * (f - 0.5 * f_lo) / (0.5 * f_lo)).cos()) } else { 0.0 };
-            let amp = taper * target.sa(1.0 / f);
-            let z = Complex::from_polar(amp, phase);
-            base[k] = z;
-            base[nfft - k] = z.conj();
-        }
         let it = Iteration {
             dt: req.dt,
             n,
@@ -650,19 +766,44 @@ pub fn synthesize_components(req: &SynthRequest, field: &str, which: &[usize]) -
             pga,
             baseline: &req.baseline,
             tolerance: req.tolerance,
-            band: req.band,
+            band,
             max_iterations: req.max_iterations,
         };
-        let r = it.run(&base, Some(&env)).map_err(|e| match e {
-            MotionError::NotMatched(m) => MotionError::NotMatched(format!("{}component {} of seed {}: {m}", if field.is_empty() { String::new() } else { format!("{field}: ") }, COMPONENT_NAMES[c], req.seed)),
-            other => other,
-        })?;
+        let mut attempt = 0;
+        let (r, stream) = loop {
+            let stream = c as u64 + 3 * attempt;
+            let mut rng = phase_stream(req.seed, stream);
+            let mut base = vec![Complex::new(0.0, 0.0); nfft];
+            for k in 1..nfft / 2 {
+                let f = k as f64 * df;
+                let phase = std::f64::consts::TAU * unit(&mut rng);
+                let taper = if f >= f_lo { 1.0 } else if f > 0.5 * f_lo { 0.5 * (1.0 - (std::f64::consts::PI * (f - 0.5 * f_lo) / (0.5 * f_lo)).cos()) } else { 0.0 };
+                let amp = taper * target.sa(1.0 / f);
+                let z = Complex::from_polar(amp, phase);
+                base[k] = z;
+                base[nfft - k] = z.conj();
+            }
+            match it.run(&base, Some(&env)) {
+                Ok(r) => break (r, stream),
+                Err(MotionError::NotMatched(m)) if attempt + 1 == ATTEMPTS => {
+                    return Err(MotionError::NotMatched(format!(
+                        "{}component {} of seed {} (phase streams {}): {m}",
+                        if field.is_empty() { String::new() } else { format!("{field}: ") },
+                        COMPONENT_NAMES[c],
+                        req.seed,
+                        (0..ATTEMPTS).map(|k| (c as u64 + 3 * k).to_string()).collect::<Vec<_>>().join(", ")
+                    )));
+                }
+                Err(MotionError::NotMatched(_)) => attempt += 1,
+                Err(other) => return Err(other),
+            }
+        };
         let name = COMPONENT_NAMES[c].to_string();
         let header = vec![
             format!("jointquake record synth: spectrum-compatible synthetic acceleration, component {name} ({}) of {}", if vertical { "vertical" } else { "horizontal" }, req.components),
             format!("command: {}", req.command()),
             format!("target: {}{}", horizontal.label, if vertical { format!(", vertical × {:.4}", req.vertical_ratio) } else { String::new() }),
-            format!("envelope: {}; random phases: ChaCha8, key = seed {}, stream {c}", req.envelope.describe(), req.seed),
+            format!("envelope: {}; random phases: ChaCha8, key = seed {}, stream {stream}{}", req.envelope.describe(), req.seed, if stream == c as u64 { String::new() } else { format!(" (streams {} did not pass)", (0..attempt).map(|k| (c as u64 + 3 * k).to_string()).collect::<Vec<_>>().join(", ")) }),
             format!("baseline: {} (applied to every iterate)", req.baseline.describe()),
             format!("match: {}", r.check.describe()),
             format!("PGA {pga:.6} g; {}", r.drift.describe()),

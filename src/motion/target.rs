@@ -14,8 +14,12 @@
 //! and other concrete structures. T_g by site class: DL 5073-2000 Table 4.3.6 (I 0.20, II 0.30,
 //! III 0.40, IV 0.65 s; the code adds 0.05 s for design intensity ≤ 8 when the structure's
 //! fundamental period exceeds 1.0 s: give `tg` for that); GB 51247-2018 §5.3.4 takes T_g from the
-//! site class and the zonation map's basic characteristic period (0.35, 0.40 or 0.45 s) as in
-//! GB 18306-2015 Table 1 (I0, I1, II, III, IV). The codes draw the spectrum to 3 s; beyond it
+//! site class and the zonation map's basic characteristic period (0.35, 0.40 or 0.45 s) through
+//! the site adjustment table of GB 18306-2015 (§8.2, Table 1; I0, I1, II, III, IV).
+//! **Unverified**: the GB 51247 table here ([`tg_gb51247`]) was written from that GB 18306-2015
+//! table as recalled by an earlier session; the code texts could not be searched here (only
+//! GB 18306-2015 §7 and the GB 51247-2018 contents were found), so check it against your copy.
+//! DL 5073-2000 stays the default. The codes draw the spectrum to 3 s; beyond it
 //! the same descending branch and floor are used (stated wherever a spectrum is written).
 //!
 //! **Table**: (T [s], Sa [g]) rows, T strictly increasing, Sa ≥ 0, linear between rows and
@@ -97,7 +101,8 @@ fn tg_dl5073(site: &str) -> Option<f64> {
     })
 }
 
-/// T_g [s] of GB 51247-2018 §5.3.4 (GB 18306-2015 Table 1) for a basic T_g and a site class.
+/// T_g [s] of GB 51247-2018 §5.3.4 (GB 18306-2015 §8.2 Table 1) for a basic T_g and a site
+/// class. Unverified against the code text (module doc).
 fn tg_gb51247(basic: f64, site: &str) -> Option<f64> {
     let row: [f64; 5] = if (basic - 0.35).abs() < 1e-9 {
         [0.20, 0.25, 0.35, 0.45, 0.65]
@@ -192,7 +197,7 @@ impl TargetSpec {
                             return Err(MotionError::invalid(format!("{field}.basic_tg"), format!("{b} s: use 0.35, 0.40 or 0.45 s")));
                         }
                         let t = tg_gb51247(b, site_class).ok_or_else(|| MotionError::invalid(format!("{field}.site_class"), format!("unknown site class \"{site_class}\" for GB 51247-2018: use I0, I1, II, III or IV")))?;
-                        ("GB 51247-2018 §5.3", t)
+                        ("GB 51247-2018 §5.3 (T_g table unverified, docs/motion.md)", t)
                     }
                     other => return Err(MotionError::invalid(format!("{field}.code"), format!("unknown code \"{other}\": use \"DL 5073-2000\" or \"GB 51247-2018\""))),
                 };

@@ -63,16 +63,17 @@ fn baseline_correction_removes_a_linear_and_quadratic_drift_exactly() {
 
 #[test]
 fn synthetic_set_matches_its_target_is_uncorrelated_deterministic_and_at_the_pga() {
-    // Stated acceptance (src/motion/synth.rs): at most 10 % of the 60 check periods (0.1–3 s)
-    // outside ±10 % of the target, none beyond ±15 %; |ρ| < 0.3 between components; the
-    // same seed gives the same bytes; PGA as requested to 1e-9, read back from the file.
+    // Acceptance rule (src/motion/synth.rs, USNRC SRP 3.7.1 Rev. 3 Option 1 Approach 2): on 189
+    // log-spaced periods 0.04–3 s (100 per decade) no point more than 10 % below the target, at
+    // most 9 adjacent points below it, none more than 30 % above; |ρ| < 0.3 between components;
+    // the same seed gives the same bytes; PGA as requested to 1e-9, read back from the file.
     let req = SynthRequest::new(arch_site_i(), 0.5575, 1);
     let set = synthesize_set(&req).unwrap();
     assert_eq!(set.components.len(), 3);
     for c in &set.components {
         assert!(c.check.passed(), "{}: {}", c.name, c.check.describe());
-        assert!(c.check.max_ratio_error <= 0.15 + 1e-12 && c.check.min_ratio_error >= -0.15 - 1e-12);
-        assert!(c.check.outside <= 6, "{}", c.check.describe());
+        assert_eq!(c.check.points, 189);
+        assert!(c.check.max_ratio_error <= 0.30 && c.check.min_ratio_error >= -0.10 && c.check.longest_run_below <= 9, "{}", c.check.describe());
         let want = if c.name == "v" { 0.5575 * 2.0 / 3.0 } else { 0.5575 };
         let pk = c.accel_g.iter().fold(0.0f64, |m, a| m.max(a.abs()));
         assert!((pk - want).abs() < 1e-9, "{} PGA {pk}", c.name);
@@ -95,6 +96,35 @@ fn synthetic_set_matches_its_target_is_uncorrelated_deterministic_and_at_the_pga
     // another seed is another record
     let other = synthesize_components(&SynthRequest::new(arch_site_i(), 0.5575, 2), "", &[0]).unwrap();
     assert!(correlation(&other.components[0].accel_g, &h1.accel_g).abs() < 0.3);
+}
+
+#[test]
+fn every_seed_1_to_10_meets_the_acceptance_rule() {
+    // Regression for seeds 3, 4 and 8, which failed the earlier ±10 % rule (0.1–3 s). Each of
+    // the 30 components of seeds 1–10 (DL 5073-2000 arch, site I, 0.5575 g, defaults) passes the
+    // SRP 3.7.1 rule over 0.04–3 s (189 periods): Sa/target − 1 ≥ −10 % at every period, ≤ +30 %,
+    // at most 9 adjacent periods below the target; |ρ| < 0.3; PGA exact to 1e-9.
+    // Measured (this code): Sa/target − 1 from −10.0 % (seed 7 v, 0.288 s) to +29.7 % (seed 8
+    // h1, 2.175 s), longest run below the target 6; seed 4 h2 uses its second phase stream.
+    let (mut lo, mut hi, mut run, mut rho) = (f64::INFINITY, f64::NEG_INFINITY, 0usize, 0.0f64);
+    for seed in 1..=10 {
+        let set = synthesize_set(&SynthRequest::new(arch_site_i(), 0.5575, seed)).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        for c in &set.components {
+            let k = &c.check;
+            assert!(k.passed() && k.points == 189, "seed {seed} {}: {}", c.name, k.describe());
+            assert!(k.min_ratio_error >= -0.10 && k.max_ratio_error <= 0.30 && k.longest_run_below <= 9, "seed {seed} {}: {}", c.name, k.describe());
+            let pk = c.accel_g.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+            assert!((pk - c.pga_g).abs() < 1e-9, "seed {seed} {} PGA {pk}", c.name);
+            lo = lo.min(k.min_ratio_error);
+            hi = hi.max(k.max_ratio_error);
+            run = run.max(k.longest_run_below);
+        }
+        for (_, _, r) in &set.correlations {
+            assert!(r.abs() < 0.3, "seed {seed}: {r}");
+            rho = rho.max(r.abs());
+        }
+    }
+    println!("seeds 1–10: Sa/target − 1 from {:+.1} % to {:+.1} %, longest run below {run}, max |ρ| {rho:.3}", 100.0 * lo, 100.0 * hi);
 }
 
 #[test]
