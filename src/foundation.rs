@@ -50,6 +50,11 @@ pub enum CondensationMethod {
 /// interface keeps the solve per step, whose factor is needed anyway.
 pub const SCHUR_MEMORY_MAX: f64 = 1024.0 * 1024.0 * 1024.0;
 
+/// Largest n_b² / nnz(L) for which the Schur complement is chosen ([`choose_method`]).
+/// Default 4: half the measured break-even's lower bound (S u_b still 8× cheaper than the
+/// solve at 1.26, the largest ratio measured), a margin for factors that stream better.
+pub const SCHUR_FILL_RATIO: f64 = 4.0;
+
 /// Right-hand sides per block when forming S. Default 32: a block solve reads the factor once
 /// for all its columns (the triangular solves are memory-bound), and 32 columns of 10⁵ unknowns
 /// (26 MB) per thread keep the working set modest.
@@ -61,16 +66,16 @@ const SCHUR_ROWS: usize = 256;
 
 /// The method of a condensation with `n_b` interface unknowns and `factor_entries` entries in
 /// the Cholesky factor of K_ff. Rule: **Schur** when the dense S fits [`SCHUR_MEMORY_MAX`] and
-/// has no more entries than the factor (n_b² ≤ nnz(L)), else **Solve**. Why: both are
-/// memory-bound; a solve per step reads L twice (forward and back substitution, 4 flops per
-/// entry) while the product reads S once (2 flops per entry), so Schur is cheaper per step as
-/// soon as n_b² < 2 nnz(L); measured (benches/foundation.rs, docs/dam_physics.md) 28× at 10⁴
-/// and 27× at 10⁵ condensed unknowns, where n_b² / nnz(L) = 0.09 and 0.05. Forming S costs
-/// n_b solves in blocks (measured ≈ n_b / 9 single solves), repaid after a few hundred steps;
-/// a run has thousands.
+/// n_b² ≤ [`SCHUR_FILL_RATIO`] × nnz(L), else **Solve**. Why: both are memory-bound; a solve per
+/// step reads L twice (forward and back substitution, 4 flops per entry) plus K_fb and a
+/// scatter, while the product reads S once (2 flops per entry). Measured (benches/foundation.rs,
+/// benches/dam.rs; docs/dam_physics.md, docs/performance.md §7): S u_b cheaper than the solve by
+/// 8× at n_b²/nnz(L) = 1.26 (arch dam, coarse), 7.5× at 0.41 (default), 25–55× at 0.09 and 0.05
+/// (foundation cubes of 10⁴ and 10⁵ unknowns). Forming S costs n_b solves in blocks (measured
+/// as much as 250–460 single solves), repaid after as many steps; a run has thousands.
 pub fn choose_method(n_b: usize, factor_entries: usize) -> CondensationMethod {
     let nb2 = (n_b as f64) * (n_b as f64);
-    if 8.0 * nb2 <= SCHUR_MEMORY_MAX && nb2 <= factor_entries as f64 {
+    if 8.0 * nb2 <= SCHUR_MEMORY_MAX && nb2 <= SCHUR_FILL_RATIO * factor_entries as f64 {
         CondensationMethod::Schur
     } else {
         CondensationMethod::Solve
@@ -347,5 +352,23 @@ impl<H: ?Sized> Constraint<H> for Condensation {
 
     fn add_internal_force_into(&mut self, u: &[f64], f: &mut [f64]) {
         self.add_schur_force_into(u, f);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_method_rule_follows_the_measured_cases() {
+        // the cases of docs/performance.md §7: foundation cubes 10⁴ and 10⁵, arch dam coarse and
+        // default (all measured faster with S), and the memory limit (n_b = 12 000: 1.15 GB)
+        assert_eq!(choose_method(675, 5_015_520), CondensationMethod::Schur);
+        assert_eq!(choose_method(3072, 191_401_389), CondensationMethod::Schur);
+        assert_eq!(choose_method(282, 63_012), CondensationMethod::Schur);
+        assert_eq!(choose_method(516, 647_406), CondensationMethod::Schur);
+        assert_eq!(choose_method(12_000, 1_000_000_000_000), CondensationMethod::Solve);
+        // a small foundation under a wide interface: S denser than 4 × the factor
+        assert_eq!(choose_method(300, 20_000), CondensationMethod::Solve);
     }
 }
