@@ -5,10 +5,12 @@
 //!
 //! Model: geo/arch_dam.geo, coarse (the committed fixture tests/fixtures/arch_dam_coarse.msh) and
 //! default (meshed by gmsh into target/bench-mesh; skipped with a message if gmsh is missing).
-//! Concrete E = 24 GPa, ν = 0.17, ρ = 2400 kg/m³; rock E = 24.5 GPa, ν = 0.25, **ρ = 2000 kg/m³:
-//! the foundation is not yet massless** (static condensation is the dam physics issue's), so the
-//! rock's nodes are stepped too and its elements enter the stable step; the numbers below are
-//! for that model. Joints: NTS, μ = 0.8, c = 0 (seed section 5), one entry `joint:{J}:left` /
+//! Concrete E = 24 GPa, ν = 0.17, ρ = 2400 kg/m³; rock E = 24.5 GPa, ν = 0.25, ρ = 2000 kg/m³,
+//! in one of the rock variants of `JQ_DAM_ROCK`: `massive` (the rock's nodes are stepped and its
+//! elements enter the stable step), `massless` (the dam study's model: `"massless": true`, the
+//! rock condensed statically, docs/dam_physics.md, by the method the rule picks; its layer
+//! along the tied base keeps its mass), or `solve` / `schur` (massless with that method forced).
+//! The massless variants also report the condensation's size and setup time. Joints: NTS, μ = 0.8, c = 0 (seed section 5), one entry `joint:{J}:left` /
 //! `joint:{J}:right`; the base `tied`. Loads: gravity plus a uniform 1 MPa downstream traction
 //! on the upstream face (a stand-in for the reservoir that puts the joints in compression, so
 //! that the pairs are active as during shaking). dt = 0.9 × the stable step. One thread.
@@ -18,11 +20,13 @@
 //! outside the other side; with the default 1e-3 those nodes are lost every step (measured: 154
 //! per step on the coarse mesh, none at 0.02).
 //! Knobs: `JQ_DAM_SIZES` (comma list of coarse, default, fine; default "coarse,default"),
+//! `JQ_DAM_ROCK` (comma list of massive, massless, solve, schur; default "massive,massless"),
 //! `JQ_BENCH_REPEATS` (default 3), `JQ_BENCH_STEPS` (default 100), `JQ_BENCH_GS_TOL` (Gauss–Seidel
 //! tolerance as a fraction of joint J01's size; default the solver's, 1e-12 of the model size),
 //! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint).
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
 
+use jointquake::foundation::CondensationMethod;
 use jointquake::mesh::Mesh;
 use jointquake::problem::Problem;
 use jointquake::scene::Scene;
@@ -48,11 +52,11 @@ fn mesh_of(size: &str) -> Result<Mesh, String> {
     Mesh::from_msh(msh).map_err(|e| e.to_string())
 }
 
-fn scene() -> Scene {
+fn scene(massless: bool) -> Scene {
     let v: serde_json::Value = serde_json::json!({
         "geometry": {"msh": "unused.msh"},
         "materials": [{"group": "block:monolith:*", "E": 24e9, "nu": 0.17, "rho": 2400.0},
-                      {"group": "block:rock", "E": 24.5e9, "nu": 0.25, "rho": 2000.0}],
+                      {"group": "block:rock", "E": 24.5e9, "nu": 0.25, "rho": 2000.0, "massless": massless}],
         "boundary": [{"group": "bc:far"}],
         "joints": [
             {"name": "J{J}", "master": "joint:{J}:left", "slave": "joint:{J}:right", "auto": true, "tolerance": 0.5, "method": "nts", "mu": 0.8, "cohesion": 0.0, "edge_tolerance": 0.02},
@@ -80,7 +84,8 @@ fn main() {
     let repeats: usize = std::env::var("JQ_BENCH_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(3usize).max(1);
     let steps: usize = std::env::var("JQ_BENCH_STEPS").ok().and_then(|v| v.parse().ok()).unwrap_or(100usize).max(1);
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
-    println!("arch dam benchmark (1 thread, load average {load}); rock NOT massless yet (ρ = 2000 kg/m³)");
+    let rocks = std::env::var("JQ_DAM_ROCK").unwrap_or_else(|_| "massive,massless".into());
+    println!("arch dam benchmark (1 thread, load average {load}); rock variants {rocks}");
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let mut rows = Vec::new();
     pool.install(|| {
@@ -94,83 +99,108 @@ fn main() {
                 }
             };
             let t_mesh = t0.elapsed().as_secs_f64();
-            let mut sc = scene();
-            sc.expand_group_patterns(&mesh_group_names(&mesh)).expect("patterns expand on the dam mesh");
-            let t1 = Instant::now();
-            let problem = Problem::build(sc, mesh).expect("dam model");
-            let t_build = t1.elapsed().as_secs_f64();
-            let model = &problem.model;
-            let mut sim = Simulation::new(&problem).expect("dam simulation");
-            let (dt_stable, dt) = (sim.time.dt_stable, sim.dt());
-            if let Some(r) = std::env::var("JQ_BENCH_GS_TOL").ok().and_then(|v| v.parse::<f64>().ok()) {
-                sim.contact.as_mut().expect("joints").gs_tolerance = r * problem.joints[0].tag.size;
-            }
-            let slaves: usize = problem.joints.iter().map(|j| j.tag.n_slave()).sum();
-            let joint_slaves: usize = problem.joints.iter().take(28).map(|j| j.tag.n_slave()).sum();
-            let mut sweeps = 0usize;
-            let step = |n: usize, sim: &mut Simulation, sweeps: &mut usize| {
-                let t = Instant::now();
-                for _ in 0..n {
-                    let info = sim.step().expect("step");
-                    *sweeps += info.correction.iterations;
+            for rock in rocks.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+                let method = match rock {
+                    "massive" | "massless" => None,
+                    "solve" => Some(CondensationMethod::Solve),
+                    "schur" => Some(CondensationMethod::Schur),
+                    other => panic!("JQ_DAM_ROCK: unknown rock variant \"{other}\" (massive, massless, solve, schur)"),
+                };
+                let mesh = mesh.clone();
+                let mut sc = scene(rock != "massive");
+                sc.expand_group_patterns(&mesh_group_names(&mesh)).expect("patterns expand on the dam mesh");
+                let t1 = Instant::now();
+                let problem = Problem::build(sc, mesh).expect("dam model");
+                let t_build = t1.elapsed().as_secs_f64();
+                let model = &problem.model;
+                let t2 = Instant::now();
+                let mut sim = Simulation::with_condensation(&problem, method).expect("dam simulation");
+                let t_sim = t2.elapsed().as_secs_f64();
+                let found = sim.foundation.as_ref().map(|f| f.info(t_sim));
+                let (dt_stable, dt) = (sim.time.dt_stable, sim.dt());
+                if let Some(r) = std::env::var("JQ_BENCH_GS_TOL").ok().and_then(|v| v.parse::<f64>().ok()) {
+                    sim.contact.as_mut().expect("joints").gs_tolerance = r * problem.joints[0].tag.size;
                 }
-                t.elapsed().as_secs_f64()
-            };
-            step(100, &mut sim, &mut sweeps);
-            sweeps = 0;
-            let events0: Vec<(u64, u64, u64, u64)> = sim.state.contact.joints.iter().map(|j| (j.events.fresh_searches, j.events.recentred, j.events.lost, j.events.projection_failures)).collect();
-            sim.contact.as_mut().expect("joints").timings = Some(Default::default());
-            let mut per_step = Vec::new();
-            for _ in 0..repeats {
-                per_step.push(step(steps, &mut sim, &mut sweeps) / steps as f64);
-            }
-            let timed = (repeats * steps) as f64;
-            let sweeps_per_step = sweeps as f64 / timed;
-            let unconverged: u64 = sim.state.contact.joints.iter().map(|j| j.unconverged_steps).sum();
-            let (mut fresh, mut recentred, mut lost, mut failures) = (0u64, 0u64, 0u64, 0u64);
-            for (j, e0) in sim.state.contact.joints.iter().zip(&events0) {
-                fresh += j.events.fresh_searches - e0.0;
-                recentred += j.events.recentred - e0.1;
-                lost += j.events.lost - e0.2;
-                failures += j.events.projection_failures - e0.3;
-            }
-            let active: usize = sim.state.contact.joints.iter().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).sum();
-            let parts = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
-            let contact = (parts.search + parts.prepare + parts.sweeps + parts.record).as_secs_f64() / parts.steps.max(1) as f64;
-            let (b, m) = (best(&per_step), median(&per_step));
-            let ne = model.n_elements();
-            let hexes = model.hexes.nodes.len();
-            let per_second = m / dt;
-            println!(
-                "  {size}: {} nodes, {ne} elements ({hexes} hex8, {} tet4), {} slave nodes ({joint_slaves} on the 28 joints), {active} pairs in compression",
-                model.n_nodes(),
-                ne - hexes,
-                slaves
-            );
-            println!("    mesh {t_mesh:.2} s, model build and tagging {t_build:.2} s; stable dt {dt_stable:.4e} s (critical element {} in {}), dt {dt:.4e} s", model.critical.tag, model.critical.group);
-            println!("    step {:.3} / {:.3} ms (best / median of {repeats} × {steps}); {:.3} µs per element; contact {:.3} ms per step = {:.3} µs per slave node", 1e3 * b, 1e3 * m, 1e6 * m / ne as f64, 1e3 * contact, 1e6 * contact / slaves.max(1) as f64);
-            println!(
-                "    Gauss–Seidel {sweeps_per_step:.1} sweeps per step ({unconverged} unconverged steps since the start); per timed step: {:.2} fresh searches, {:.2} recentred, {:.2} lost, {:.2} projection failures",
-                fresh as f64 / timed,
-                recentred as f64 / timed,
-                lost as f64 / timed,
-                failures as f64 / timed
-            );
-            if std::env::var("JQ_DAM_PER_JOINT").is_ok() {
-                for (j, (cj, e0)) in sim.state.contact.joints.iter().zip(problem.joints.iter().zip(&events0)) {
-                    println!("      {:5} lost {:8} fresh {:8} unconverged {:6} max sweeps {:5}", cj.tag.name, j.events.lost - e0.2, j.events.fresh_searches - e0.0, j.unconverged_steps, j.max_sweeps);
+                let slaves: usize = problem.joints.iter().map(|j| j.tag.n_slave()).sum();
+                let joint_slaves: usize = problem.joints.iter().take(28).map(|j| j.tag.n_slave()).sum();
+                let mut sweeps = 0usize;
+                let step = |n: usize, sim: &mut Simulation, sweeps: &mut usize| {
+                    let t = Instant::now();
+                    for _ in 0..n {
+                        let info = sim.step().expect("step");
+                        *sweeps += info.correction.iterations;
+                    }
+                    t.elapsed().as_secs_f64()
+                };
+                step(100, &mut sim, &mut sweeps);
+                sweeps = 0;
+                let events0: Vec<(u64, u64, u64, u64)> = sim.state.contact.joints.iter().map(|j| (j.events.fresh_searches, j.events.recentred, j.events.lost, j.events.projection_failures)).collect();
+                sim.contact.as_mut().expect("joints").timings = Some(Default::default());
+                let mut per_step = Vec::new();
+                for _ in 0..repeats {
+                    per_step.push(step(steps, &mut sim, &mut sweeps) / steps as f64);
                 }
+                let timed = (repeats * steps) as f64;
+                let sweeps_per_step = sweeps as f64 / timed;
+                let unconverged: u64 = sim.state.contact.joints.iter().map(|j| j.unconverged_steps).sum();
+                let (mut fresh, mut recentred, mut lost, mut failures) = (0u64, 0u64, 0u64, 0u64);
+                for (j, e0) in sim.state.contact.joints.iter().zip(&events0) {
+                    fresh += j.events.fresh_searches - e0.0;
+                    recentred += j.events.recentred - e0.1;
+                    lost += j.events.lost - e0.2;
+                    failures += j.events.projection_failures - e0.3;
+                }
+                let active: usize = sim.state.contact.joints.iter().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).sum();
+                let parts = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
+                let contact = (parts.search + parts.prepare + parts.sweeps + parts.record).as_secs_f64() / parts.steps.max(1) as f64;
+                let (b, m) = (best(&per_step), median(&per_step));
+                let ne = model.n_elements();
+                let hexes = model.hexes.nodes.len();
+                let per_second = m / dt;
+                // the condensation's own cost per step, apart from the step (whose time the contact
+                // dominates): a solve for u_f, and S u_b when S is formed; best of 20 calls each
+                let mut cond_ms = (f64::NAN, f64::NAN);
+                if let (Some(i), Some(f)) = (&found, sim.foundation.as_mut()) {
+                    let mut u = sim.state.u.clone();
+                    let mut fi = vec![0.0; u.len()];
+                    let best_of = |g: &mut dyn FnMut()| (0..20).map(|_| { let t = Instant::now(); g(); t.elapsed().as_secs_f64() }).fold(f64::INFINITY, f64::min);
+                    cond_ms.0 = 1e3 * best_of(&mut || f.condense_into(&mut u));
+                    if i.method == CondensationMethod::Schur {
+                        cond_ms.1 = 1e3 * best_of(&mut || f.add_schur_force_into(&u, &mut fi));
+                    }
+                    println!("  {size}, rock {rock}: condensation {:?}, {} condensed on {} interface unknowns, factor {} entries, S {:.1} MB, setup {:.2} s; per step: solve {:.3} ms, S·u_b {:.3} ms", i.method, i.condensed_unknowns, i.interface_unknowns, i.factor_entries, i.schur_bytes as f64 / 1e6, i.setup_time, cond_ms.0, cond_ms.1);
+                }
+                println!(
+                    "  {size}, rock {rock}: {} nodes, {ne} elements ({hexes} hex8, {} tet4), {} slave nodes ({joint_slaves} on the 28 joints), {active} pairs in compression",
+                    model.n_nodes(),
+                    ne - hexes,
+                    slaves
+                );
+                println!("    mesh {t_mesh:.2} s, model build and tagging {t_build:.2} s; stable dt {dt_stable:.4e} s (critical element {} in {}), dt {dt:.4e} s", model.critical.tag, model.critical.group);
+                println!("    step {:.3} / {:.3} ms (best / median of {repeats} × {steps}); {:.3} µs per element; contact {:.3} ms per step = {:.3} µs per slave node", 1e3 * b, 1e3 * m, 1e6 * m / ne as f64, 1e3 * contact, 1e6 * contact / slaves.max(1) as f64);
+                println!(
+                    "    Gauss–Seidel {sweeps_per_step:.1} sweeps per step ({unconverged} unconverged steps since the start); per timed step: {:.2} fresh searches, {:.2} recentred, {:.2} lost, {:.2} projection failures",
+                    fresh as f64 / timed,
+                    recentred as f64 / timed,
+                    lost as f64 / timed,
+                    failures as f64 / timed
+                );
+                if std::env::var("JQ_DAM_PER_JOINT").is_ok() {
+                    for (j, (cj, e0)) in sim.state.contact.joints.iter().zip(problem.joints.iter().zip(&events0)) {
+                        println!("      {:5} lost {:8} fresh {:8} unconverged {:6} max sweeps {:5}", cj.tag.name, j.events.lost - e0.2, j.events.fresh_searches - e0.0, j.unconverged_steps, j.max_sweeps);
+                    }
+                }
+                println!("    one second of earthquake: {:.0} steps, {per_second:.1} s of wall time (target < 20 s on the default mesh)", 1.0 / dt);
+                rows.push(serde_json::json!({
+                    "size": size, "rock": rock, "condensation": found, "condensation_solve_ms": cond_ms.0, "condensation_schur_product_ms": cond_ms.1, "nodes": model.n_nodes(), "elements": ne, "hex8": hexes, "tet4": ne - hexes,
+                    "slave_nodes": slaves, "joint_slave_nodes": joint_slaves, "pairs_in_compression": active,
+                    "dt_stable": dt_stable, "dt": dt, "critical_element": model.critical.tag, "critical_group": model.critical.group,
+                    "step_s": per_step, "best_step_s": b, "median_step_s": m, "us_per_element": 1e6 * m / ne as f64,
+                    "contact_s_per_step": contact, "contact_us_per_slave_node": 1e6 * contact / slaves.max(1) as f64,
+                    "wall_s_per_earthquake_second": per_second, "gs_sweeps_per_step": sweeps_per_step, "unconverged_steps": unconverged,
+                    "fresh_searches_per_step": fresh as f64 / timed, "recentred_per_step": recentred as f64 / timed, "lost_per_step": lost as f64 / timed, "mesh_s": t_mesh, "build_s": t_build,
+                }));
             }
-            println!("    one second of earthquake: {:.0} steps, {per_second:.1} s of wall time (target < 20 s on the default mesh)", 1.0 / dt);
-            rows.push(serde_json::json!({
-                "size": size, "nodes": model.n_nodes(), "elements": ne, "hex8": hexes, "tet4": ne - hexes,
-                "slave_nodes": slaves, "joint_slave_nodes": joint_slaves, "pairs_in_compression": active,
-                "dt_stable": dt_stable, "dt": dt, "critical_element": model.critical.tag, "critical_group": model.critical.group,
-                "step_s": per_step, "best_step_s": b, "median_step_s": m, "us_per_element": 1e6 * m / ne as f64,
-                "contact_s_per_step": contact, "contact_us_per_slave_node": 1e6 * contact / slaves.max(1) as f64,
-                "wall_s_per_earthquake_second": per_second, "gs_sweeps_per_step": sweeps_per_step, "unconverged_steps": unconverged,
-                "fresh_searches_per_step": fresh as f64 / timed, "recentred_per_step": recentred as f64 / timed, "lost_per_step": lost as f64 / timed, "mesh_s": t_mesh, "build_s": t_build,
-            }));
         }
     });
     let _ = std::fs::create_dir_all(root().join("target/bench"));

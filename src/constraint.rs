@@ -51,4 +51,15 @@ pub trait Constraint<H: ?Sized> {
     /// Correct `u_next` (the predicted u[n+1]) in place; `history` is the part of the run's
     /// state the constraint may update.
     fn correct(&mut self, model: &Model, history: &mut H, step: &StepContext<'_>, u_next: &mut [f64]) -> Result<ConstraintInfo, StepError>;
+
+    /// Whether this constraint stands for the stiffness of the massless elements (the condensed
+    /// foundation's Schur complement): the step's element loop then leaves those elements out
+    /// and adds [`Constraint::add_internal_force_into`] instead. Default false.
+    fn replaces_massless_elements(&self) -> bool {
+        false
+    }
+
+    /// f += the internal force of what this constraint stands for, at the displacements `u`
+    /// (only called when [`Constraint::replaces_massless_elements`]). Default: nothing.
+    fn add_internal_force_into(&mut self, _u: &[f64], _f: &mut [f64]) {}
 }

@@ -93,6 +93,9 @@ pub enum StepError {
     EnergyGrowth { step: usize, t: f64, error: f64, limit: f64, node: usize, x: [f64; 3], cause: String },
     #[error("{0}")]
     Contact(String),
+    /// Reconstructing the massless foundation's displacements (out of memory for the solve).
+    #[error("massless foundation: {0}")]
+    Foundation(String),
 }
 
 /// Running the gmsh command line.

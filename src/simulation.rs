@@ -35,6 +35,14 @@ pub trait Observer {
     }
     /// After dynamic step `k` (0-based) of `n_steps`.
     fn observe(&mut self, sim: &Simulation<'_>, k: usize, n_steps: usize) -> Result<(), Error>;
+    /// Whether [`Observer::observe`] after step `k` reads the displacements of the condensed
+    /// foundation's nodes (frames, monitors there). With the Schur-complement condensation they
+    /// are reconstructed only then (one solve) and are 0 in the state otherwise
+    /// (`foundation`). Default true (always right; an observer that knows its schedule says
+    /// when).
+    fn full_state_due(&self, _sim: &Simulation<'_>, _k: usize, _n_steps: usize) -> bool {
+        true
+    }
     /// After the last step.
     fn finish(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
         Ok(())
@@ -59,7 +67,7 @@ pub struct Simulation<'p> {
     /// The contact correction (`None` without joints).
     pub contact: Option<ContactSolver<'p>>,
     /// The static condensation of the massless blocks (`None` without them); runs after the
-    /// contact correction.
+    /// contact correction (solve per step) or in the element loop (Schur complement).
     pub foundation: Option<crate::foundation::Condensation>,
     pub state: State,
     /// The outcome of [`Self::equilibrate`] (`None` before it, or without gravity relaxation).
@@ -71,18 +79,28 @@ pub struct Simulation<'p> {
 impl<'p> Simulation<'p> {
     /// A run at rest at t = 0 with the scene's time step.
     pub fn new(problem: &'p Problem) -> Result<Simulation<'p>, Error> {
+        Self::with_condensation(problem, None)
+    }
+
+    /// [`Simulation::new`] with the massless foundation's condensation method given (`None`:
+    /// the rule of `foundation::choose_method`); for tests and benchmarks that compare them.
+    pub fn with_condensation(problem: &'p Problem, method: Option<crate::foundation::CondensationMethod>) -> Result<Simulation<'p>, Error> {
         let model = &problem.model;
         let contact = (!problem.joints.is_empty()).then(|| ContactSolver::new(model, &problem.joints));
         let penalty = contact.as_ref().map(|c| c.penalty_omega2_bound(model)).unwrap_or(0.0);
         let t0 = std::time::Instant::now();
-        let foundation = crate::foundation::Condensation::build(model, faer::Par::Seq).map_err(|e| ModelError::Invalid(e.to_string()))?;
+        let foundation = crate::foundation::Condensation::build(model, faer::Par::Seq, method).map_err(|e| ModelError::Invalid(e.to_string()))?;
         let mut notes = problem.notes.clone();
         // the condensed foundation stiffens the interface: its ω² bound adds to the elements'
         let found_w2 = foundation.as_ref().map(|f| f.omega2_bound()).unwrap_or(0.0);
         if let Some(f) = foundation.as_ref() {
             let i = f.info(t0.elapsed().as_secs_f64());
+            let how = match i.method {
+                crate::foundation::CondensationMethod::Solve => "a solve per step".to_string(),
+                crate::foundation::CondensationMethod::Schur => format!("dense Schur complement on the interface, {:.1} MB", i.schur_bytes as f64 / 1e6),
+            };
             notes.push(format!(
-                "massless blocks: {} unknowns condensed on {} interface unknowns (factor {} entries, {:.2} s); foundation ω² bound {:.4e} 1/s² in the stable step",
+                "massless blocks: {} unknowns condensed on {} interface unknowns ({how}; factor {} entries; setup {:.2} s); foundation ω² bound {:.4e} 1/s² in the stable step",
                 i.condensed_unknowns, i.interface_unknowns, i.factor_entries, i.setup_time, i.omega2_bound
             ));
         }
@@ -147,7 +165,28 @@ impl<'p> Simulation<'p> {
         if let Some(f) = self.foundation.as_mut() {
             cs.push(f);
         }
-        relax_gravity(&p.model, &p.loads, &mut self.solver, &mut self.state, &mut cs, tol, max_steps)
+        let eq = relax_gravity(&p.model, &p.loads, &mut self.solver, &mut self.state, &mut cs, tol, max_steps)?;
+        self.complete_state()?;
+        Ok(eq)
+    }
+
+    /// Give the state's displacement vectors (u[n−1], u[n], u[n+1]) the condensed foundation's
+    /// part where they lack it (Schur complement: one solve; nothing otherwise). Called after
+    /// relaxation and before every observation that reads the foundation.
+    pub fn complete_state(&mut self) -> Result<(), StepError> {
+        if let Some(f) = self.foundation.as_mut() {
+            f.complete_into([&mut self.state.u, &mut self.state.u_prev, &mut self.solver.u_nm1]).map_err(|e| StepError::Foundation(e.to_string()))?;
+        }
+        Ok(())
+    }
+
+    /// Zero the condensed foundation's part of the state's displacement vectors (Schur
+    /// complement, when no observer reads it: no stale mixture of reconstructed and zero
+    /// vectors); nothing otherwise.
+    fn clear_condensed_state(&mut self) {
+        if let Some(f) = self.foundation.as_mut() {
+            f.clear_into([&mut self.state.u, &mut self.state.u_prev, &mut self.solver.u_nm1]);
+        }
     }
 
     /// Restart the clock at t = 0 from the current state (taken as at rest) and the energy
@@ -186,6 +225,11 @@ impl<'p> Simulation<'p> {
         observer.start(self)?;
         for k in 0..n {
             self.step()?;
+            if observer.full_state_due(self, k, n) {
+                self.complete_state()?;
+            } else {
+                self.clear_condensed_state();
+            }
             observer.observe(self, k, n)?;
         }
         observer.finish(self)

@@ -81,6 +81,20 @@ fn for_each_entry(v: &mut [f64], f: impl Fn(usize, &mut f64) + Sync + Send) {
     });
 }
 
+/// f = K u of the step: the model's element loop, except when a constraint stands for the
+/// massless elements (the condensed foundation's Schur complement S, `foundation`): then the
+/// loop leaves them out and the constraint adds S u_b on the interface.
+fn internal_forces_into(model: &Model, constraints: &mut [&mut dyn Constraint<ContactState>], u: &[f64], f: &mut [f64]) {
+    if constraints.iter().any(|c| c.replaces_massless_elements()) {
+        model.internal_forces_of_massive_into(u, f);
+        for c in constraints.iter_mut().filter(|c| c.replaces_massless_elements()) {
+            c.add_internal_force_into(u, f);
+        }
+    } else {
+        model.internal_forces_into(u, f);
+    }
+}
+
 /// Running energy account of the dynamic stage [J].
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energy {
@@ -232,13 +246,13 @@ impl ExplicitSolver {
         if beta > 0.0 {
             let c = beta / dt;
             for_each_entry(&mut self.w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
-            model.internal_forces_into(&self.w, &mut self.f_int);
+            internal_forces_into(model, constraints, &self.w, &mut self.f_int);
             // f_int = (1 + c) K u[n] − c K u[n−1] by linearity, so K u[n] follows exactly from
             // K u[n−1] (a recursion that damps its own round-off by c/(1+c) < 1 per step).
             let (f_int, ku_prev) = (&self.f_int, &self.ku_prev);
             for_each_entry(&mut self.ku, |i, k| *k = (f_int[i] + c * ku_prev[i]) / (1.0 + c));
         } else {
-            model.internal_forces_into(&state.u, &mut self.f_int);
+            internal_forces_into(model, constraints, &state.u, &mut self.f_int);
         }
         let dt2 = dt * dt;
         // energy increments over the step, Δu_c = (u[n+1] − u[n−1]) / 2: W_ext, D_α, D_β, and

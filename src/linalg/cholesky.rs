@@ -78,6 +78,15 @@ impl SparseCholesky {
         }
         LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, MemStack::new(&mut self.scratch));
     }
+
+    /// X ← A⁻¹ X with a scratch of its own (one thread): for blocks of right-hand sides solved
+    /// in parallel on a shared factorisation.
+    pub fn solve_block_in_place(&self, rhs: MatMut<'_, f64>) -> Result<(), LinalgError> {
+        let n = self.n();
+        let mut scratch = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), Par::Seq)).map_err(|_| LinalgError::OutOfMemory { what: "solve scratch".into(), n })?;
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut scratch));
+        Ok(())
+    }
 }
 
 #[cfg(test)]

@@ -623,6 +623,17 @@ impl Model {
 
     /// f = K u (f is overwritten). Deterministic whatever the thread count.
     pub fn internal_forces_into(&self, u: &[f64], f: &mut [f64]) {
+        self.internal_forces_where_into::<false>(u, f)
+    }
+
+    /// f = K u of the elements that carry mass: the elements of massless blocks
+    /// ([`Model::massless_cells`]) left out, for a step that applies the condensed foundation's
+    /// Schur complement instead (`foundation`). Same order and sums otherwise.
+    pub fn internal_forces_of_massive_into(&self, u: &[f64], f: &mut [f64]) {
+        self.internal_forces_where_into::<true>(u, f)
+    }
+
+    fn internal_forces_where_into<const SKIP_MASSLESS: bool>(&self, u: &[f64], f: &mut [f64]) {
         if f.len() < 4 * NODAL_BLOCK {
             f.fill(0.0);
         } else {
@@ -641,6 +652,9 @@ impl Model {
             std::hint::black_box(s);
         };
         self.tets.schedule.for_each_element(warm, |e| {
+            if SKIP_MASSLESS && self.massless_cells[self.tets.cell[e] as usize] {
+                return;
+            }
             let nd = &self.tets.nodes[e];
             let ue: [[f64; 3]; 4] = std::array::from_fn(|a| {
                 let i = 3 * nd[a] as usize;
@@ -661,6 +675,9 @@ impl Model {
             }
         });
         self.hexes.schedule.for_each_element(warm, |e| {
+            if SKIP_MASSLESS && self.massless_cells[self.hexes.cell[e] as usize] {
+                return;
+            }
             let nd = &self.hexes.nodes[e];
             let ue: [[f64; 3]; 8] = std::array::from_fn(|a| {
                 let i = 3 * nd[a] as usize;
