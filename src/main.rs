@@ -159,7 +159,7 @@ enum Cmd {
     /// (and writes result.json). Options and defaults: docs/cli.md.
     Testcase {
         /// patch (uniform pressure/shear through the joint, static), slide (block on an
-        /// incline), impact (two bars).
+        /// incline), newmark (the block under a base record against rigid Newmark), impact (two bars).
         kind: String,
         /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2.
         #[arg(long)]
@@ -203,6 +203,12 @@ enum Cmd {
         /// Patch: relaxation residual at which the static solve stops.
         #[arg(long)]
         residual: Option<f64>,
+        /// Newmark: base record (t [s], a [g]).
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Newmark: PGA of the record [g].
+        #[arg(long)]
+        pga: Option<f64>,
         /// The joint's edge_tolerance (fraction of the master face size).
         #[arg(long)]
         edge_tolerance: Option<f64>,
@@ -533,10 +539,12 @@ fn real_main() -> Result<()> {
         }
         Cmd::Study { action } => study_cmd(action)?,
         Cmd::Record { action } => record_cmd(action)?,
-        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, out, run, json } => {
+        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, record, pga, out, run, json } => {
             // the options as the study file writes a case (one parser and one set of checks)
             let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
-            let opts: [(&str, serde_json::Value); 13] = [
+            let opts: [(&str, serde_json::Value); 15] = [
+                ("record", record.map(|p| p.display().to_string()).into()),
+                ("pga", pga.into()),
                 ("edge_tolerance", edge_tolerance.into()),
                 ("lower", lower.into()),
                 ("upper", upper.into()),

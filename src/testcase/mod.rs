@@ -31,6 +31,11 @@
 //!   statically (dynamic relaxation with adaptive critical damping, [`run`]).
 //! - `slide`: a 1 × 0.5 × 0.5 m block on a 4 × 1 × 0.5 m base inclined at β, μ < tan β, gravity
 //!   from rest: s(t) = ½ g (sin β − μ cos β) t² down the slope (refs/analytic.py B).
+//! - `newmark`: the `slide` geometry with μ ≥ tan β (the block holds under gravity), gravity
+//!   relaxed, then a horizontal base record along the rising direction (default El Centro 1940
+//!   N–S scaled to 0.5 g, 10 s): the residual slip down the slope against the rigid-block
+//!   Newmark integration of `rigid::newmark::slide_block` (one-way, cohesionless) under the same
+//!   ground motion (docs/validation.md §6).
 //! - `impact`: two bars 0.1 × 0.1 × 1 m along the local z axis (E = 2 GPa, ρ = 2000 kg/m³,
 //!   c = 1000 m/s, ν = 0), the lower one moving at v0 = 1 m/s into the upper one at rest:
 //!   contact force ρ c A v0 / 2 for 2L/c (refs/analytic.py C; docs/validation.md §1).
@@ -52,6 +57,7 @@ use std::path::{Path, PathBuf};
 pub enum Kind {
     Patch,
     Slide,
+    Newmark,
     Impact,
 }
 
@@ -61,8 +67,9 @@ impl std::str::FromStr for Kind {
         match s {
             "patch" => Ok(Kind::Patch),
             "slide" => Ok(Kind::Slide),
+            "newmark" => Ok(Kind::Newmark),
             "impact" => Ok(Kind::Impact),
-            _ => Err(format!("\"{s}\" is not a testcase kind (patch, slide, impact)")),
+            _ => Err(format!("\"{s}\" is not a testcase kind (patch, slide, newmark, impact)")),
         }
     }
 }
@@ -190,6 +197,13 @@ pub struct CaseSpec {
     /// Patch: relaxation residual ‖M a‖ / ‖F‖ at which the static solve stops. Default 1e-10.
     #[serde(default)]
     pub residual: Option<f64>,
+    /// Newmark: the base record (two columns t [s], a [g]; docs/scenes.md `loads.base`). Default
+    /// `pipelines/records/elcentro1940_NS_chopra.txt` (relative to the current directory).
+    #[serde(default)]
+    pub record: Option<PathBuf>,
+    /// Newmark: the record's PGA [g]. Default 0.5.
+    #[serde(default)]
+    pub pga: Option<f64>,
     /// The joint's `edge_tolerance` (fraction of the master face size; docs/scenes.md). Default:
     /// the scene's default (1e-3). A bonded or sticking slave node on the joint's perimeter that
     /// carries a tangential force is searched at its contact-free prediction, which leaves the
@@ -235,6 +249,9 @@ pub struct Resolved {
     pub duration: f64,
     pub residual: f64,
     pub edge_tolerance: Option<f64>,
+    /// Newmark: the record (absolute path) and its PGA [g].
+    pub record: Option<PathBuf>,
+    pub pga: f64,
 }
 
 fn invalid(option: &str, message: impl Into<String>) -> Error {
@@ -247,15 +264,15 @@ impl CaseSpec {
         let k = self.kind;
         let (dl, du) = match k {
             Kind::Patch => ("hex8:4:2", "hex8:3:2"),
-            Kind::Slide => ("hex8:2:2", "hex8:4:2"),
+            Kind::Slide | Kind::Newmark => ("hex8:2:2", "hex8:4:2"),
             Kind::Impact => ("hex8:1:100", "hex8:1:100"),
         };
         let lower = self.lower.unwrap_or_else(|| dl.parse().expect("default side"));
         let upper = self.upper.unwrap_or_else(|| du.parse().expect("default side"));
         let finer = if lower.n > upper.n { Side::Lower } else { Side::Upper };
         let slave = match (k, self.slave) {
-            (Kind::Slide, Some(Side::Lower)) => return Err(invalid("slave", "slide: the slave must be the slider (upper): its nodes stay on the base while it slides")),
-            (Kind::Slide, _) => Side::Upper,
+            (Kind::Slide | Kind::Newmark, Some(Side::Lower)) => return Err(invalid("slave", "slide, newmark: the slave must be the slider (upper): its nodes stay on the base while it slides")),
+            (Kind::Slide | Kind::Newmark, _) => Side::Upper,
             (_, Some(s)) => s,
             (_, None) => finer,
         };
@@ -274,6 +291,7 @@ impl CaseSpec {
         let mu = self.mu.unwrap_or(match k {
             Kind::Patch => 0.6,
             Kind::Slide => 0.3,
+            Kind::Newmark => 35f64.to_radians().tan(),
             Kind::Impact => 0.0,
         });
         if !(mu.is_finite() && mu >= 0.0) {
@@ -290,16 +308,32 @@ impl CaseSpec {
         if k == Kind::Patch && !self.tied && (shear.abs() >= mu * pressure) {
             return Err(invalid("shear", format!("|τ| = {} ≥ μ p = {}: the joint would slide (no static solution); lower τ or use tied", shear.abs(), mu * pressure)));
         }
-        let inclination = self.inclination.unwrap_or(if k == Kind::Slide { 30.0 } else { 0.0 });
+        let inclination = self.inclination.unwrap_or(if matches!(k, Kind::Slide | Kind::Newmark) { 30.0 } else { 0.0 });
         if !(inclination.is_finite() && inclination.abs() < 80.0) {
             return Err(invalid("inclination", format!("{inclination}: give |β| < 80 deg")));
         }
-        if k == Kind::Slide && inclination <= 0.0 {
-            return Err(invalid("inclination", "slide: give β > 0 (the slope)"));
+        if matches!(k, Kind::Slide | Kind::Newmark) && inclination <= 0.0 {
+            return Err(invalid("inclination", "slide, newmark: give β > 0 (the slope)"));
         }
-        let duration = self.duration.unwrap_or(1.0);
-        if !(duration.is_finite() && duration > 0.0 && duration <= 10.0) {
-            return Err(invalid("duration", format!("{duration}: give 0 < duration ≤ 10 s")));
+        if k == Kind::Newmark && mu < inclination.to_radians().tan() {
+            return Err(invalid("mu", format!("newmark: μ = {mu} < tan β = {:.4}: the block slides under gravity alone (use the slide kind)", inclination.to_radians().tan())));
+        }
+        if k != Kind::Newmark && (self.record.is_some() || self.pga.is_some()) {
+            return Err(invalid("record/pga", "only the newmark kind takes a base record"));
+        }
+        let pga = self.pga.unwrap_or(0.5);
+        if !(pga.is_finite() && pga > 0.0 && pga <= 3.0) {
+            return Err(invalid("pga", format!("{pga}: give 0 < PGA ≤ 3 g")));
+        }
+        let record = if k == Kind::Newmark {
+            let p = self.record.clone().unwrap_or_else(|| PathBuf::from("pipelines/records/elcentro1940_NS_chopra.txt"));
+            Some(std::fs::canonicalize(&p).map_err(|e| invalid("record", format!("{}: {e} (give --record FILE, two columns t [s], a [g]; the default is relative to the repository root)", p.display())))?)
+        } else {
+            None
+        };
+        let duration = self.duration.unwrap_or(if k == Kind::Newmark { 10.0 } else { 1.0 });
+        if !(duration.is_finite() && duration > 0.0 && duration <= 60.0) {
+            return Err(invalid("duration", format!("{duration}: give 0 < duration ≤ 60 s")));
         }
         let residual = self.residual.unwrap_or(1e-10);
         if !(residual.is_finite() && residual > 0.0 && residual < 1e-2) {
@@ -313,11 +347,11 @@ impl CaseSpec {
         }
         // size of the problem: refuse what would not fit in memory before allocating it
         let cells = |s: &SideSpec, len: usize| s.n * s.n * len * s.layers * if s.element == Element::Tet4 { 6 } else { 1 };
-        let total = cells(&lower, if k == Kind::Slide { 4 } else { 1 }) + cells(&upper, 1);
+        let total = cells(&lower, if matches!(k, Kind::Slide | Kind::Newmark) { 4 } else { 1 }) + cells(&upper, 1);
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
-        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance })
+        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, record, pga })
     }
 }
 
@@ -368,6 +402,9 @@ pub enum Reference {
     Patch { stress: [f64; 6], pressure: f64, shear: f64, formula: String },
     /// Slip down the slope s(t) = ½ g (sin β − μ cos β) t² at `duration` [m] (0 if μ ≥ tan β).
     Slide { duration: f64, slip: f64, acceleration: f64, formula: String },
+    /// Residual slip of the rigid block [m] under the scene's ground motion (Newmark, one-way,
+    /// cohesionless, friction angle atan μ), its yield acceleration [g] and sliding episodes.
+    Newmark { duration: f64, slip: f64, yield_acceleration: f64, episodes: usize, formula: String },
     /// Contact force ρ c A v0 / 2 [N] for 2L/c [s]; bar velocities after: 0 and v0.
     Impact { force: f64, duration: f64, v0: f64, formula: String },
 }
@@ -384,8 +421,11 @@ pub struct Case {
 pub fn build(spec: &CaseSpec) -> Result<Case, Error> {
     let r = spec.resolved()?;
     let mesh = case_mesh(&r);
-    let reference = reference(&r);
     let scene = case_scene(&r);
+    let reference = match r.kind {
+        Kind::Newmark => newmark_reference(&r, &scene)?,
+        _ => reference(&r),
+    };
     Ok(Case { spec: r, mesh, scene, reference })
 }
 
@@ -404,7 +444,7 @@ pub fn case_mesh(r: &Resolved) -> Mesh {
             add_box(&mut mesh, &side_box("lower", &r.lower, [a, a, h], [0.0, 0.0, -h], [1.0, 1.0]));
             add_box(&mut mesh, &side_box("upper", &r.upper, [a, a, h], [0.0, 0.0, 0.0], [1.0, 1.0]));
         }
-        Kind::Slide => {
+        Kind::Slide | Kind::Newmark => {
             // base 4 × 1 × 0.5 m from x = −0.5; slider 1 × 0.5 × 0.5 m at x ∈ [2, 3], y ∈ [0.25, 0.75]
             add_box(&mut mesh, &side_box("lower", &r.lower, [4.0, 1.0, 0.5], [-0.5, 0.0, -0.5], [4.0, 1.0]));
             add_box(&mut mesh, &side_box("upper", &r.upper, [1.0, 0.5, 0.5], [2.0, 0.25, 0.0], [1.0, 0.5]));
@@ -457,6 +497,28 @@ pub fn patch_tractions(r: &Resolved) -> Vec<(String, [f64; 3])> {
     out
 }
 
+/// The rigid block under the scene's own ground motion (its base records as the run applies them).
+fn newmark_reference(r: &Resolved, scene: &Value) -> Result<Reference, Error> {
+    use crate::rigid::newmark::{slide_block, Direction, Incline, NewmarkOptions};
+    let sc: crate::scene::Scene = serde_json::from_value(scene.clone()).map_err(|e| invalid("record", format!("generated scene: {e}")))?;
+    let (motions, _) = crate::dynamics::loads::base_motions(&sc)?;
+    let dt = motions.iter().map(|b| b.record.dt).fold(f64::INFINITY, f64::min);
+    let n = (r.duration / dt).round() as usize + 1;
+    let a: Vec<[f64; 3]> = (0..n).map(|i| crate::dynamics::loads::ground_acceleration_of(&motions, i as f64 * dt)).collect();
+    // the plane rises along global +x (R e_x = (cos β, 0, sin β)): a_h positive into the hill
+    let a_h: Vec<f64> = a.iter().map(|v| v[0]).collect();
+    let phi = r.mu.atan().to_degrees();
+    let incline = Incline { g: G, ..Incline::frictional(r.inclination, phi) };
+    let nm = slide_block(&incline, Direction::OneWay, &a_h, None, &NewmarkOptions::new(dt))?;
+    Ok(Reference::Newmark {
+        duration: r.duration,
+        slip: nm.residual_displacement,
+        yield_acceleration: incline.yield_acceleration_down()? / G,
+        episodes: nm.n_episodes,
+        formula: "rigid block on the incline, one-way Newmark sliding (rigid::newmark::slide_block), φ = atan μ, under the same ground motion".into(),
+    })
+}
+
 fn reference(r: &Resolved) -> Reference {
     match r.kind {
         Kind::Patch => Reference::Patch {
@@ -465,6 +527,7 @@ fn reference(r: &Resolved) -> Reference {
             shear: r.shear,
             formula: "uniform state of ν = 0: σzz = −p, σxz = τ in every element (local frame); contact pressure p and shear τ at every slave node (r = p A_s, |r_t| = |τ| A_s)".into(),
         },
+        Kind::Newmark => unreachable!("newmark_reference"),
         Kind::Slide => {
             let b = r.inclination.to_radians();
             let a = (G * (b.sin() - r.mu * b.cos())).max(0.0);
@@ -499,7 +562,7 @@ pub fn case_scene(r: &Resolved) -> Value {
     }
     let (e, nu, rho) = match r.kind {
         Kind::Patch => (PATCH_E, 0.0, PATCH_RHO),
-        Kind::Slide => (SLIDE_E, SLIDE_NU, SLIDE_RHO),
+        Kind::Slide | Kind::Newmark => (SLIDE_E, SLIDE_NU, SLIDE_RHO),
         Kind::Impact => (BAR_E, 0.0, BAR_RHO),
     };
     if r.method == ContactMethod::Penalty {
@@ -534,6 +597,14 @@ pub fn case_scene(r: &Resolved) -> Value {
             sc["boundary"] = json!([{"group": "lower:z0"}]);
             sc["loads"] = json!({"gravity": {"g": G}});
             sc["equilibrium"] = json!({"method": "none"});
+            sc["time"] = json!({"duration": r.duration, "courant": 0.9});
+        }
+        Kind::Newmark => {
+            // gravity relaxed first (the scene's default equilibrium), then the record along +x
+            // (into the hill); stiffness damping ξ ≈ 0.1 % at 10 Hz against chatter (docs/contact.md)
+            sc["boundary"] = json!([{"group": "lower:z0"}]);
+            sc["loads"] = json!({"gravity": {"g": G}, "base": [{"record": r.record, "direction": [1.0, 0.0, 0.0], "pga": r.pga}]});
+            sc["damping"] = json!({"beta": 3.2e-5});
             sc["time"] = json!({"duration": r.duration, "courant": 0.9});
         }
         Kind::Impact => {
