@@ -118,7 +118,7 @@ incline:
 	$(MAKE) --no-print-directory study STUDY=pipelines/incline_study.json
 
 # The joint-test matrix (docs/validation.md §8): generated mismatched-mesh cases (patch, slide,
-# impact; `jointquake testcase`) against their exact references, one line each in
+# newmark, impact; `jointquake testcase`) against their exact references, one line each in
 # pipelines/joint_tests_study.json; out/joint-tests/report.md (about 1 min on 2 cores).
 joint-tests:
 	$(MAKE) --no-print-directory study STUDY=pipelines/joint_tests_study.json
