@@ -28,7 +28,7 @@ pub fn kind_of(study: &Study) -> Result<Box<dyn StudyKind>, Error> {
             }
             Box::new(RunsKind)
         }
-        other => return Err(StudyError::Invalid { path: study.path.clone(), message: format!("`report.kind` = \"{other}\" is not a study kind (kinds: wedge, incline, joint_tests, runs)") }.into()),
+        other => return Err(StudyError::Invalid { path: study.path.clone(), message: format!("`report.kind` = \"{other}\" is not a study kind (kinds: wedge, incline, runs, joint_tests)") }.into()),
     })
 }
 
