@@ -19,7 +19,7 @@ JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline
+.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -116,6 +116,12 @@ wedge-report:
 # committed incline fixture against the rigid Newmark block (6 runs of about 12 s; out/incline).
 incline:
 	$(MAKE) --no-print-directory study STUDY=pipelines/incline_study.json
+
+# The joint-test matrix (docs/validation.md §8): generated mismatched-mesh cases (patch, slide,
+# newmark, impact; `jointquake testcase`) against their exact references, one line each in
+# pipelines/joint_tests_study.json; out/joint-tests/report.md (about 1 min on 2 cores).
+joint-tests:
+	$(MAKE) --no-print-directory study STUDY=pipelines/joint_tests_study.json
 
 bench: build
 	cargo bench --bench explicit

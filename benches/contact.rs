@@ -16,6 +16,13 @@
 //! - `JQ_BENCH_STEPS`: steps per repeat, default 400;
 //! - `JQ_BENCH_GS_TOL`: Gauss–Seidel tolerance as a fraction of the joint size, default the
 //!   solver's (1e-12).
+//!
+//! Tied case (issue 13 §3: what a large bonded interface costs), after the main case and
+//! without touching it (its state hash stays the same): the same model with the joint `tied`
+//! at `JQ_BENCH_TIED_N` (default 100: 99 × 99 upper cells, 10⁴ slave nodes, 8 × 10⁴ hex8),
+//! `JQ_BENCH_TIED_STEPS` steps per repeat (default 50) and 3 repeats, against its contact-free
+//! model; reported as the step ratio and the cost per pair per step, as for the main case.
+//! `JQ_BENCH_TIED_N=0` skips it.
 use jointquake::mesh::structured::{add_box, BoxSpec};
 use jointquake::mesh::Mesh;
 use jointquake::problem::Problem;
@@ -23,10 +30,16 @@ use jointquake::simulation::Simulation;
 use std::time::Instant;
 
 fn build(n: usize, with_joint: bool) -> Problem {
+    build_with(n, with_joint, false)
+}
+
+fn build_with(n: usize, with_joint: bool, tied: bool) -> Problem {
     let mut mesh = Mesh { source: "<bench>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
     add_box(&mut mesh, &BoxSpec::new("lower", [1.0, 1.0, 0.2], [n, n, 4]).at([0.0, 0.0, -0.2]));
     add_box(&mut mesh, &BoxSpec::new("upper", [1.0, 1.0, 0.2], [n - 1, n - 1, 4]));
-    let joints = if with_joint {
+    let joints = if with_joint && tied {
+        serde_json::json!([{"name": "J", "master": "lower:z1", "slave": "upper:z0", "mu": 0.5, "tied": true}])
+    } else if with_joint {
         serde_json::json!([{"name": "J", "master": "lower:z1", "slave": "upper:z0", "mu": 0.5}])
     } else {
         serde_json::json!([])
@@ -152,5 +165,46 @@ fn main() {
         });
         let _ = std::fs::create_dir_all("target/bench");
         let _ = std::fs::write("target/bench/contact.json", serde_json::to_string_pretty(&json).unwrap());
+        tied_case();
     });
+}
+
+/// The tied interface of 10⁴ pairs (module docs): contact-free and tied steps in turn.
+fn tied_case() {
+    let n: usize = std::env::var("JQ_BENCH_TIED_N").ok().and_then(|v| v.parse().ok()).unwrap_or(100);
+    if n < 2 {
+        return;
+    }
+    let steps: usize = std::env::var("JQ_BENCH_TIED_STEPS").ok().and_then(|v| v.parse().ok()).unwrap_or(50);
+    let repeats = 3;
+    let free = build_with(n, false, false);
+    let tied = build_with(n, true, true);
+    let pairs = tied.joints[0].tag.n_slave();
+    let mut a = Run::new(&free);
+    let mut b = Run::new(&tied);
+    a.steps(steps);
+    b.steps(steps);
+    b.sweeps = 0;
+    let (mut t_free, mut t_tied, mut per_pair, mut ratio) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..repeats {
+        let tf = a.steps(steps);
+        let tw = b.steps(steps);
+        t_free.push(1e6 * tf / steps as f64);
+        t_tied.push(1e6 * tw / steps as f64);
+        per_pair.push(1e6 * (tw - tf) / (pairs * steps) as f64);
+        ratio.push(tw / tf);
+    }
+    let best = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let sweeps = b.sweeps as f64 / (repeats * steps) as f64;
+    println!("tied interface (1 thread): n = {n}, {} nodes, {} hex8, {pairs} tied pairs", tied.model.n_nodes(), tied.model.n_elements());
+    println!("  {repeats} repeats of {steps} steps; best / median");
+    println!("  contact-free step   {:9.1} / {:9.1} µs", best(&t_free), median(&t_free));
+    println!("  step with the joint {:9.1} / {:9.1} µs", best(&t_tied), median(&t_tied));
+    println!("  ratio               {:9.2} / {:9.2}", best(&ratio), median(&ratio));
+    println!("  per tied pair       {:9.3} / {:9.3} µs per step, Gauss–Seidel sweeps {sweeps:.1} per step", best(&per_pair), median(&per_pair));
+    let json = serde_json::json!({
+        "n": n, "nodes": tied.model.n_nodes(), "elements": tied.model.n_elements(), "pairs": pairs, "steps_per_repeat": steps, "repeats": repeats,
+        "step_contact_free_us": t_free, "step_tied_us": t_tied, "ratio": ratio, "per_pair_us": per_pair, "sweeps_per_step": sweeps,
+    });
+    let _ = std::fs::write("target/bench/contact_tied.json", serde_json::to_string_pretty(&json).unwrap());
 }

@@ -32,6 +32,8 @@ pub enum Error {
     Report(#[from] ReportError),
     #[error(transparent)]
     Study(#[from] StudyError),
+    #[error(transparent)]
+    Case(#[from] CaseError),
 }
 
 /// Reading a `.msh` file or looking up its parts.
@@ -128,6 +130,13 @@ pub enum StudyError {
     Io { path: PathBuf, message: String },
     #[error("study {path}: {message}")]
     Invalid { path: PathBuf, message: String },
+}
+
+/// A generated joint test case (`testcase` module): names the option to fix.
+#[derive(Debug, Error)]
+pub enum CaseError {
+    #[error("testcase: option `{option}`: {message}")]
+    Invalid { option: String, message: String },
 }
 
 /// Writing results.

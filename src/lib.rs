@@ -59,6 +59,7 @@ pub mod simulation;
 pub mod studies;
 pub mod scene_patterns;
 pub mod study;
+pub mod testcase;
 pub mod vtk;
 
 pub use error::{Error, Result};

@@ -154,6 +154,74 @@ enum Cmd {
         #[command(subcommand)]
         action: RecordCmd,
     },
+    /// A generated joint test with its exact reference (patch, slide, impact): writes
+    /// <out>/case.msh, scene.json, reference.json; with --run solves it and prints the error
+    /// (and writes result.json). Options and defaults: docs/cli.md.
+    Testcase {
+        /// patch (uniform pressure/shear through the joint, static), slide (block on an
+        /// incline), newmark (the block under a base record against rigid Newmark), impact (two bars).
+        kind: String,
+        /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2.
+        #[arg(long)]
+        lower: Option<String>,
+        /// Upper side ELEMENT:N[:LAYERS].
+        #[arg(long)]
+        upper: Option<String>,
+        /// Slave side: lower or upper (default the finer side).
+        #[arg(long)]
+        slave: Option<String>,
+        /// Contact method: nts, ntn or penalty.
+        #[arg(long)]
+        method: Option<String>,
+        /// Penalty factor k (kn = k E/h of the slave), with --method penalty.
+        #[arg(long)]
+        penalty: Option<f64>,
+        /// Candidate layer 1 or 2.
+        #[arg(long)]
+        layer: Option<u8>,
+        /// Friction coefficient.
+        #[arg(long)]
+        mu: Option<f64>,
+        /// Bonded joint.
+        #[arg(long)]
+        tied: bool,
+        /// Patch: pressure p [Pa].
+        #[arg(long)]
+        pressure: Option<f64>,
+        /// Patch: shear τ along the joint's x [Pa].
+        #[arg(long, allow_negative_numbers = true)]
+        shear: Option<f64>,
+        /// Joint inclination β [deg] about y.
+        #[arg(long, allow_negative_numbers = true)]
+        inclination: Option<f64>,
+        /// Patch: the lower block massless (condensed).
+        #[arg(long)]
+        massless_lower: bool,
+        /// Slide: simulated time [s].
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Patch: relaxation residual at which the static solve stops.
+        #[arg(long)]
+        residual: Option<f64>,
+        /// Newmark: base record (t [s], a [g]).
+        #[arg(long)]
+        record: Option<PathBuf>,
+        /// Newmark: PGA of the record [g].
+        #[arg(long)]
+        pga: Option<f64>,
+        /// The joint's edge_tolerance (fraction of the master face size).
+        #[arg(long)]
+        edge_tolerance: Option<f64>,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+        /// Run the case and print its error against the reference.
+        #[arg(long)]
+        run: bool,
+        /// Print the result as JSON (with --run).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// Ground-motion stages (docs/motion.md).
@@ -471,6 +539,51 @@ fn real_main() -> Result<()> {
         }
         Cmd::Study { action } => study_cmd(action)?,
         Cmd::Record { action } => record_cmd(action)?,
+        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, record, pga, out, run, json } => {
+            // the options as the study file writes a case (one parser and one set of checks)
+            let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
+            let opts: [(&str, serde_json::Value); 15] = [
+                ("record", record.map(|p| p.display().to_string()).into()),
+                ("pga", pga.into()),
+                ("edge_tolerance", edge_tolerance.into()),
+                ("lower", lower.into()),
+                ("upper", upper.into()),
+                ("slave", slave.into()),
+                ("method", method.into()),
+                ("penalty", penalty.into()),
+                ("layer", layer.into()),
+                ("mu", mu.into()),
+                ("pressure", pressure.into()),
+                ("shear", shear.into()),
+                ("inclination", inclination.into()),
+                ("duration", duration.into()),
+                ("residual", residual.into()),
+            ];
+            for (k, v) in opts {
+                if !v.is_null() {
+                    o[k] = v;
+                }
+            }
+            let spec: jointquake::testcase::CaseSpec = serde_json::from_value(o).context("testcase options (docs/cli.md, `testcase`)")?;
+            let case = jointquake::testcase::build(&spec)?;
+            let files = jointquake::testcase::write_case(&case, &out)?;
+            say!("case      {}", case.spec.label());
+            say!("mesh      {} ({} nodes, {} cells)", files.msh.display(), case.mesh.nodes.len(), case.mesh.cells.len());
+            say!("scene     {}", files.scene.display());
+            say!("reference {}", files.reference.display());
+            if run {
+                let r = jointquake::testcase::run::run_case(&case).with_context(|| format!("running {}", case.spec.label()))?;
+                let p = out.join("result.json");
+                std::fs::write(&p, serde_json::to_string_pretty(&r)?).with_context(|| format!("writing {}", p.display()))?;
+                if json {
+                    say!("{}", serde_json::to_string_pretty(&r)?);
+                } else {
+                    say!("result    {}", p.display());
+                    say!("error     {:.4e} ({}), {} steps, {:.2} s", r.error, r.error_of, r.steps, r.wall_time);
+                    say!("details   {}", serde_json::to_string(&r.errors)?);
+                }
+            }
+        }
     }
     Ok(())
 }

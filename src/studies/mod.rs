@@ -3,11 +3,13 @@
 //! file's `report.kind`.
 //!
 //! Kinds: `wedge` ([`wedge`]: the Hoek & Bray wedge of the seed paper), `incline`
-//! ([`incline`]: a block on an incline against the rigid Newmark block), `runs` (the run table
+//! ([`incline`]: a block on an incline against the rigid Newmark block), `joint_tests`
+//! ([`joint_tests`]: generated mismatched-mesh cases against exact references), `runs` (the run table
 //! only: any study). Adding a kind: a module here implementing [`StudyKind`] and a line in
 //! [`kind_of`] (docs/studies.md).
 
 pub mod incline;
+pub mod joint_tests;
 pub mod wedge;
 
 use crate::error::{Error, StudyError};
@@ -19,13 +21,14 @@ pub fn kind_of(study: &Study) -> Result<Box<dyn StudyKind>, Error> {
     Ok(match study.kind.as_str() {
         "wedge" => Box::new(wedge::WedgeKind::new(study)?),
         "incline" => Box::new(incline::InclineKind::new(study)?),
+        "joint_tests" => Box::new(joint_tests::JointTestsKind::new(study)?),
         "runs" => {
             if !study.params.is_empty() {
                 return Err(StudyError::Invalid { path: study.path.clone(), message: "`report` (kind \"runs\") takes no parameters".into() }.into());
             }
             Box::new(RunsKind)
         }
-        other => return Err(StudyError::Invalid { path: study.path.clone(), message: format!("`report.kind` = \"{other}\" is not a study kind (kinds: wedge, incline, runs)") }.into()),
+        other => return Err(StudyError::Invalid { path: study.path.clone(), message: format!("`report.kind` = \"{other}\" is not a study kind (kinds: wedge, incline, runs, joint_tests)") }.into()),
     })
 }
 

@@ -11,6 +11,7 @@ mod contact_validation;
 mod dam_physics;
 mod dynamics;
 mod fuzz;
+mod joint_tests;
 mod mesh;
 mod motion;
 mod motion_scene;

@@ -1,0 +1,270 @@
+//! Running a generated case in memory and measuring it against its exact reference.
+//!
+//! - `patch` is solved **statically** by dynamic relaxation with adaptive critical damping
+//!   (Underwood 1983, `dynamics::relax_gravity`: C = αM with α = 2 ω_min, ω_min² the Rayleigh
+//!   quotient uᵀKu / uᵀMu of the current displacement, re-estimated every step, so the lowest
+//!   mode is critically damped without a damping chosen by hand). The patch tractions are
+//!   handed to it as static forces (the loads relaxation applies with gravity), ramped in over
+//!   `RELAXATION_RAMP_STEPS` steps; it stops when the out-of-balance force ‖M a‖ (elastic and
+//!   contact forces together) is below `residual` × ‖F‖ (default 1e-10).
+//! - `slide` runs the dynamic stage from rest with gravity for `duration`.
+//! - `newmark` relaxes gravity (the scene's `equilibrium`), then runs the record; the slip is
+//!   measured from the relaxed state.
+//! - `impact` starts the lower bar at v0 (central differences carry v[n−½] = (u[n] − u[n−1])/dt,
+//!   so u[−1] = −v0 dt on its nodes) and runs 3 L/c.
+//!
+//! Error measures (all relative; the module docs of [`super`] give the frame):
+//! - patch: `stress_joint` = max over the elements whose centroid lies within one element layer
+//!   of the joint of max_ij |σ_ij − σ_ij exact| / s with s = max(p, |τ|); `szz_joint` the same for
+//!   σzz alone / p (the measure quoted for CalculiX); `stress_all` over every element;
+//!   `pressure` = max over slave nodes of |r_n − p A_s| / (s A_s) (`pressure_interior`: nodes
+//!   off the joint's perimeter); `shear` = max |r_t − τ A_s e_x| / (s A_s); `total` = Σ r_n /
+//!   (p A) − 1.
+//! - slide: (s_FEM − s) / s with s_FEM the mean displacement of the slider's nodes down the
+//!   slope at the end.
+//! - impact: plateau mean, min and max of the contact force over 0.2–1.8 L/c / F − 1, and the
+//!   contact duration / (2L/c) − 1.
+
+use super::{Case, Kind, Reference, Side, BAR_L, BAR_V0, PATCH_SIDE};
+use crate::error::{CaseError, Error};
+use crate::problem::Problem;
+use crate::scene::Scene;
+use crate::simulation::Simulation;
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// What a case measured (written as `result.json` and as a study step's output).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CaseResult {
+    pub label: String,
+    pub spec: super::Resolved,
+    /// h_slave / h_master (in-plane element sizes).
+    pub mesh_ratio: f64,
+    pub nodes: usize,
+    pub elements: usize,
+    /// Slave nodes (pairs) of the joint.
+    pub pairs: usize,
+    pub dt: f64,
+    pub steps: usize,
+    /// Wall time of the solve [s] (model build excluded).
+    pub wall_time: f64,
+    /// The headline error and what it measures.
+    pub error: f64,
+    pub error_of: String,
+    pub errors: Errors,
+    /// Node-steps without a master face (NTS search), summed over the run.
+    pub lost: u64,
+}
+
+/// The measures of each kind (see the module docs).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum Errors {
+    Patch {
+        stress_joint: f64,
+        szz_joint: f64,
+        stress_all: f64,
+        pressure: f64,
+        pressure_interior: f64,
+        shear: f64,
+        total: f64,
+        /// Relaxation: converged, its residual ‖M a‖ / ‖F‖.
+        converged: bool,
+        residual: f64,
+    },
+    Slide {
+        slip: f64,
+        exact: f64,
+        relative: f64,
+    },
+    Impact {
+        force_mean: f64,
+        force_min: f64,
+        force_max: f64,
+        duration: f64,
+    },
+}
+
+fn failed(message: String) -> Error {
+    CaseError::Invalid { option: "run".into(), message }.into()
+}
+
+/// Build the problem of `case`, run it and measure it.
+pub fn run_case(case: &Case) -> Result<CaseResult, Error> {
+    let scene: Scene = serde_json::from_value(case.scene.clone()).map_err(|e| failed(format!("generated scene does not parse: {e}")))?;
+    let mut pb = Problem::build(scene, case.mesh.clone())?;
+    if case.spec.kind == Kind::Patch {
+        // the tractions act as static loads (what relaxation applies), not as dynamic patterns
+        for p in std::mem::take(&mut pb.loads.patterns) {
+            pb.loads.static_forces.extend(p.forces);
+        }
+    }
+    let mut sim = Simulation::new(&pb)?;
+    let t0 = std::time::Instant::now();
+    let (errors, steps) = match (&case.reference, case.spec.kind) {
+        (Reference::Patch { .. }, Kind::Patch) => {
+            let eq = sim.relax(case.spec.residual, 400_000)?;
+            (measure_patch(case, &sim, eq.converged, eq.residual), eq.steps)
+        }
+        (Reference::Slide { slip, .. }, Kind::Slide) => {
+            let n = sim.n_steps();
+            for _ in 0..n {
+                sim.step()?;
+            }
+            let rot = case.spec.rotation();
+            let nodes = pb.model.mesh.group_nodes("block:upper")?;
+            let down = -(rot * Vector3::x());
+            let s = nodes.iter().map(|&i| Vector3::new(sim.state.u[3 * i], sim.state.u[3 * i + 1], sim.state.u[3 * i + 2]).dot(&down)).sum::<f64>() / nodes.len() as f64;
+            let relative = if *slip > 0.0 { s / slip - 1.0 } else { s };
+            (Errors::Slide { slip: s, exact: *slip, relative }, n)
+        }
+        (Reference::Newmark { slip, .. }, Kind::Newmark) => {
+            sim.equilibrate()?;
+            let nodes = pb.model.mesh.group_nodes("block:upper")?;
+            let down = -(case.spec.rotation() * Vector3::x());
+            let along = |u: &[f64]| nodes.iter().map(|&i| Vector3::new(u[3 * i], u[3 * i + 1], u[3 * i + 2]).dot(&down)).sum::<f64>() / nodes.len() as f64;
+            let s0 = along(&sim.state.u);
+            let n = sim.n_steps();
+            for _ in 0..n {
+                sim.step()?;
+            }
+            let s = along(&sim.state.u) - s0;
+            let relative = if *slip > 1e-6 { s / slip - 1.0 } else { s };
+            (Errors::Slide { slip: s, exact: *slip, relative }, n)
+        }
+        (Reference::Impact { force, duration, .. }, Kind::Impact) => run_impact(case, &mut sim, *force, *duration)?,
+        _ => return Err(failed("reference and kind disagree".into())),
+    };
+    let wall_time = t0.elapsed().as_secs_f64();
+    let (error, error_of) = match &errors {
+        Errors::Patch { szz_joint, stress_joint, .. } => {
+            if case.spec.pressure > 0.0 && case.spec.shear == 0.0 {
+                (*szz_joint, "σzz next to the joint".to_string())
+            } else {
+                (*stress_joint, "σ next to the joint".to_string())
+            }
+        }
+        Errors::Slide { relative, .. } if case.spec.kind == Kind::Newmark => (relative.abs(), "residual slip vs rigid Newmark".to_string()),
+        Errors::Slide { relative, .. } => (relative.abs(), "slip at the end".to_string()),
+        Errors::Impact { force_mean, .. } => (force_mean.abs(), "plateau contact force".to_string()),
+    };
+    let joint = &pb.joints[0];
+    Ok(CaseResult {
+        label: case.spec.label(),
+        spec: case.spec.clone(),
+        mesh_ratio: case.spec.mesh_ratio(),
+        nodes: pb.model.n_nodes(),
+        elements: pb.model.n_elements(),
+        pairs: joint.tag.slave_nodes().len(),
+        dt: sim.dt(),
+        steps,
+        wall_time,
+        error,
+        error_of,
+        errors,
+        lost: sim.state.contact.joints[0].events.lost,
+    })
+}
+
+fn measure_patch(case: &Case, sim: &Simulation<'_>, converged: bool, residual: f64) -> Errors {
+    let r = &case.spec;
+    let pb = sim.problem;
+    let model = &pb.model;
+    let rot = r.rotation();
+    let exact = [0.0, 0.0, -r.pressure, 0.0, 0.0, r.shear];
+    let s_ref = r.pressure.max(r.shear.abs());
+    let mut stress = Vec::new();
+    model.element_stress_into(&sim.state.u, &mut stress);
+    let blocks = model.element_blocks();
+    let layer = [super::PATCH_HEIGHT / r.lower.layers as f64, super::PATCH_HEIGHT / r.upper.layers as f64];
+    let (mut stress_joint, mut szz_joint, mut stress_all) = (0.0f64, 0.0f64, 0.0f64);
+    for (e, (_, nodes)) in model.element_cells().iter().enumerate() {
+        let c = nodes.iter().map(|&n| model.mesh.x(n as usize)).sum::<Vector3<f64>>() / nodes.len() as f64;
+        let z = (rot.transpose() * c)[2];
+        let s = stress[e];
+        let g = nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
+        let l = rot.transpose() * g * rot;
+        let local = [l[(0, 0)], l[(1, 1)], l[(2, 2)], l[(0, 1)], l[(1, 2)], l[(0, 2)]];
+        let dev = (0..6).map(|i| (local[i] - exact[i]).abs()).fold(0.0, f64::max) / s_ref;
+        stress_all = stress_all.max(dev);
+        let b = blocks[e] as usize;
+        if z.abs() < layer[b.min(1)] {
+            stress_joint = stress_joint.max(dev);
+            if r.pressure > 0.0 {
+                szz_joint = szz_joint.max((local[2] - exact[2]).abs() / r.pressure);
+            }
+        }
+    }
+    // contact forces on the slave nodes: exact σ n_s A_s (n_s the slave's outward normal)
+    let joint = &pb.joints[0];
+    let pairs = &sim.state.contact.joints[0].pairs;
+    let n_s = match r.slave {
+        Side::Upper => -Vector3::z(),
+        Side::Lower => Vector3::z(),
+    };
+    let sig = nalgebra::Matrix3::new(exact[0], exact[3], exact[5], exact[3], exact[1], exact[4], exact[5], exact[4], exact[2]);
+    let t_exact = sig * n_s;
+    let t_tangent = rot * (t_exact - n_s * n_s.dot(&t_exact));
+    let (mut pressure, mut pressure_interior, mut shear, mut total) = (0.0f64, 0.0f64, 0.0f64, 0.0);
+    for (i, p) in pairs.iter().enumerate() {
+        let a = joint.tag.areas[i];
+        let node = joint.tag.slave_nodes()[i];
+        let dp = (p.r_n - r.pressure * a).abs() / (s_ref * a);
+        pressure = pressure.max(dp);
+        let x = rot.transpose() * model.mesh.x(node);
+        let tol = 1e-9 * PATCH_SIDE;
+        if [x[0], x[1]].iter().all(|&c| c > tol && c < PATCH_SIDE - tol) {
+            pressure_interior = pressure_interior.max(dp);
+        }
+        let f = &joint.frames[i];
+        let ft = f[1] * p.r_t[0] + f[2] * p.r_t[1];
+        shear = shear.max((ft - t_tangent * a).norm() / (s_ref * a));
+        total += p.r_n;
+    }
+    let area: f64 = joint.tag.areas.iter().sum();
+    let total = if r.pressure > 0.0 { total / (r.pressure * area) - 1.0 } else { total / (s_ref * area) };
+    Errors::Patch { stress_joint, szz_joint, stress_all, pressure, pressure_interior, shear, total, converged, residual }
+}
+
+fn run_impact(case: &Case, sim: &mut Simulation<'_>, force: f64, duration: f64) -> Result<(Errors, usize), Error> {
+    let pb = sim.problem;
+    let model = &pb.model;
+    let dt = sim.dt();
+    let dir = case.spec.rotation() * Vector3::z();
+    let bar = model.mesh.group_nodes("block:lower")?;
+    for &n in &bar {
+        for c in 0..3 {
+            sim.state.u_prev[3 * n + c] = -BAR_V0 * dt * dir[c];
+        }
+    }
+    sim.solver.start_energy(model, &mut sim.state);
+    let e0: f64 = bar.iter().map(|&n| 0.5 * model.mass.inertial[n] * BAR_V0 * BAR_V0).sum();
+    sim.state.energy.initial = e0;
+    sim.state.energy.scale = e0;
+    let lc = duration / 2.0;
+    let _ = BAR_L;
+    let steps = (3.0 * lc / dt).round() as usize;
+    let (mut first, mut last) = (f64::NAN, f64::NAN);
+    let (mut sum, mut count, mut f_min, mut f_max) = (0.0, 0usize, f64::INFINITY, f64::NEG_INFINITY);
+    for _ in 0..steps {
+        let t = sim.state.t;
+        sim.step()?;
+        let f: f64 = sim.state.contact.joints[0].pairs.iter().map(|p| p.r_n).sum();
+        if f > 1e-6 * force {
+            if first.is_nan() {
+                first = t;
+            }
+            last = t;
+        }
+        if t > 0.2 * lc && t < 1.8 * lc {
+            sum += f;
+            count += 1;
+            f_min = f_min.min(f);
+            f_max = f_max.max(f);
+        }
+    }
+    if count == 0 || first.is_nan() {
+        return Err(failed("impact: no contact force during the plateau (the bars never touched)".into()));
+    }
+    Ok((Errors::Impact { force_mean: sum / count as f64 / force - 1.0, force_min: f_min / force - 1.0, force_max: f_max / force - 1.0, duration: (last - first + dt) / duration - 1.0 }, steps))
+}

@@ -1,0 +1,168 @@
+//! Generated joint tests (`jointquake testcase`, src/testcase): a coarse subset of the matrix
+//! of `make joint-tests` (pipelines/joint_tests_study.json, docs/validation.md §8) with the
+//! measured errors as bounds. Each bound is about 1.25 × the measurement it names (so that a
+//! regression of a quarter fails); every run also checks that the static solve converged.
+//! References: the patch kind's uniform state (σzz = −p, σxz = τ, contact pressure p at every
+//! slave node; ν = 0), s(t) = ½ g (sin β − μ cos β) t² for the slide, ρ c A v0 / 2 for 2L/c
+//! for the impact (src/testcase/mod.rs).
+use jointquake::testcase::run::{run_case, CaseResult, Errors};
+use jointquake::testcase::{build, CaseSpec};
+use serde_json::json;
+
+fn case(v: serde_json::Value) -> CaseResult {
+    let spec: CaseSpec = serde_json::from_value(v.clone()).expect("case spec");
+    let c = build(&spec).expect("case builds");
+    let r = run_case(&c).expect("case runs");
+    println!("{v}: error {:.4e} ({}), {:?}, lost {}", r.error, r.error_of, r.errors, r.lost);
+    if let Errors::Patch { converged, residual, total, .. } = &r.errors {
+        assert!(*converged && *residual < 1e-10, "{v}: static solve not converged ({residual:.2e})");
+        // global equilibrium of the joint: Σ r_n = p A (or ≈ 0 in pure shear, relative to τ A)
+        assert!(total.abs() < 1e-6, "{v}: Σ r_n off by {total:.2e}");
+    }
+    r
+}
+
+fn patch_errors(r: &CaseResult) -> (f64, f64, f64) {
+    match &r.errors {
+        Errors::Patch { stress_joint, pressure_interior, shear, .. } => (*stress_joint, *pressure_interior, *shear),
+        e => panic!("not a patch: {e:?}"),
+    }
+}
+
+/// Conforming joints pass exactly: hex 3×3 on 3×3 and tet 3×3 on 3×3, NTS and NTN.
+/// Measured: σ 1.2e-10 (hex, both methods), 5.0e-10 (tet). Bound 1e-8 (the relaxation stops at
+/// a residual of 1e-10).
+#[test]
+fn conforming_patch_is_exact() {
+    for v in [
+        json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3"}),
+        json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "method": "ntn"}),
+        json!({"kind": "patch", "lower": "tet4:3", "upper": "tet4:3"}),
+    ] {
+        let r = case(v);
+        let (s, p, _) = patch_errors(&r);
+        assert!(s < 1e-8 && p < 1e-8, "conforming patch: σ {s:.2e}, pressure {p:.2e}");
+    }
+}
+
+/// Hex 4×4 on 3×3, pressure only (the CalculiX comparison case, 34 % for its node-to-face).
+/// Measured σzz next to the joint: NTS finer slave 8.40 %, coarser slave 15.0 %, NTN 62.2 %
+/// (docs/validation.md §2 gives the same three from the dynamic recipe: 8.4 %, 15.0 %, 12.4/62.3 %).
+/// Bounds: NTS finer 0.105; the order finer < coarser < NTN.
+#[test]
+fn patch_4x4_over_3x3_orders_the_methods() {
+    let base = json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3"});
+    let with = |k: &str, v: serde_json::Value| {
+        let mut b = base.clone();
+        b[k] = v;
+        b
+    };
+    let finer = case(with("slave", json!("lower")));
+    let coarser = case(with("slave", json!("upper")));
+    let mut ntn = with("slave", json!("lower"));
+    ntn["method"] = json!("ntn");
+    let ntn = case(ntn);
+    assert!(finer.error < 0.105, "NTS finer slave σzz {:.4}", finer.error);
+    assert!(finer.error < coarser.error && coarser.error < ntn.error, "order: finer {:.4}, coarser {:.4}, NTN {:.4}", finer.error, coarser.error, ntn.error);
+}
+
+/// Tet over hex, 4×4 tets on 3×3 hexes, NTS with the finer (tet) side as slave.
+/// Measured σzz 22.3 %; bound 0.28. Same grid, different face types (tet 3×3 on hex 3×3, nodes
+/// coincide): 18.1 % whichever side is slave (no node-based method can pass it); bound 0.23.
+#[test]
+fn tet_over_hex_patch_within_measured_bounds() {
+    let r = case(json!({"kind": "patch", "lower": "tet4:4", "upper": "hex8:3", "slave": "lower"}));
+    assert!(r.error < 0.28, "tet4 4×4 on hex 3×3: σzz {:.4}", r.error);
+    let r = case(json!({"kind": "patch", "lower": "tet4:3", "upper": "hex8:3", "slave": "lower"}));
+    assert!(r.error < 0.23 && r.error > 0.05, "tet4 3×3 on hex 3×3: σzz {:.4}", r.error);
+}
+
+/// Issue 13 §3: a tied NTS interface between non-conforming meshes (hex 4×4 slave on 3×3)
+/// passes a uniform stress with the error of NTS (measured σzz 8.40 %, bound 0.105) and a
+/// uniform shear (pure shear τ = 1 MPa, p = 0, edge_tolerance 0.05: σ 5.89 %, shear traction
+/// 18.0 %; bounds 0.074 and 0.225); the same next to a massless lower block (8.41 %; 5.83 %);
+/// conforming pure shear with edge_tolerance 0.05: 0.173 % (bound 0.0022).
+#[test]
+fn tied_interface_passes_uniform_stress_and_shear() {
+    let tied = json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "tied": true});
+    let r = case(tied.clone());
+    assert!(r.error < 0.105, "tied pressure σzz {:.4}", r.error);
+    let mut m = tied.clone();
+    m["massless_lower"] = json!(true);
+    let r = case(m);
+    assert!(r.error < 0.105, "tied pressure on a massless block σzz {:.4}", r.error);
+    let mut shear = tied.clone();
+    shear["pressure"] = json!(0.0);
+    shear["shear"] = json!(1e6);
+    shear["edge_tolerance"] = json!(0.05);
+    let r = case(shear.clone());
+    let (s, _, t) = patch_errors(&r);
+    assert!(s < 0.074 && t < 0.225, "tied pure shear: σ {s:.4}, shear traction {t:.4}");
+    assert_eq!(r.lost, 0);
+    let mut sm = shear.clone();
+    sm["massless_lower"] = json!(true);
+    let r = case(sm);
+    let (s, _, t) = patch_errors(&r);
+    assert!(s < 0.074 && t < 0.225, "tied pure shear on a massless block: σ {s:.4}, shear traction {t:.4}");
+    let mut c = shear;
+    c["lower"] = json!("hex8:3");
+    c["slave"] = json!("upper");
+    let r = case(c);
+    assert!(r.error < 0.0022, "conforming tied pure shear σ {:.4e}", r.error);
+}
+
+/// Finding (docs/validation.md §8, not fixed here: the contact search is outside this change):
+/// at the default edge_tolerance (1e-3 of the master face size) the slave nodes on the
+/// perimeter of a tied joint in pure shear are searched at their contact-free prediction,
+/// which leaves the master by dt² F/m (about 8e-4 m here, against 5e-4 m of tolerance), so they
+/// are lost and carry no force: σ error 83 % on the conforming 3×3 joint (measured 0.833).
+/// When the search is fixed, this test fails: update docs/validation.md §8 and drop it.
+#[test]
+fn tied_pure_shear_loses_perimeter_nodes_at_the_default_edge_tolerance() {
+    let r = case(json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "tied": true, "pressure": 0.0, "shear": 1e6}));
+    assert!(r.lost > 0 && r.error > 0.5, "lost {} σ {:.3}", r.lost, r.error);
+}
+
+/// Slide: hex 4/m slider on a hex 2/m base at β = 30°, μ = 0.3, 1 s: measured +0.096 %
+/// (docs/validation.md §4 gives +0.085 % on its fixture); bound 0.0012. Impact of two bars with
+/// non-matching cross-sections (2×2 on 3×3): plateau mean −(1.5e-4), min/max within 0.9 %;
+/// bounds 2e-4 and 2 % (the validation's tolerance).
+#[test]
+fn slide_and_impact_match_their_references() {
+    let r = case(json!({"kind": "slide"}));
+    assert!(r.error < 0.0012, "slide slip error {:.4e}", r.error);
+    let r = case(json!({"kind": "impact", "lower": "hex8:2:100", "upper": "hex8:3:100"}));
+    assert!(r.error < 2e-4, "impact plateau mean {:.3e}", r.error);
+    if let Errors::Impact { force_min, force_max, duration, .. } = r.errors {
+        assert!(force_min.abs() < 0.02 && force_max.abs() < 0.02 && duration.abs() < 0.02, "impact plateau [{force_min}, {force_max}], duration {duration}");
+    }
+}
+
+/// Bad options name the option and the fix.
+#[test]
+fn bad_testcase_options_are_named() {
+    let e = serde_json::from_value::<CaseSpec>(json!({"kind": "patch", "lower": "hex9:4"})).unwrap_err().to_string();
+    assert!(e.contains("ELEMENT:N"), "{e}");
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "shear": 7e5})).unwrap();
+    let e = build(&spec).err().expect("τ ≥ μ p is refused").to_string();
+    assert!(e.contains("`shear`") && e.contains("tied"), "{e}");
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "slide", "slave": "lower"})).unwrap();
+    assert!(build(&spec).err().unwrap().to_string().contains("`slave`"));
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "lower": "hex8:200:200", "upper": "hex8:200:200"})).unwrap();
+    assert!(build(&spec).err().unwrap().to_string().contains("million"));
+}
+
+/// `write_case` writes a mesh the reader takes back with the joint's groups, and a scene that
+/// `Scene::load` accepts.
+#[test]
+fn written_case_reads_back() {
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "lower": "tet4:4", "upper": "hex8:3", "inclination": 20.0})).unwrap();
+    let c = build(&spec).unwrap();
+    let dir = crate::common::scratch("testcase_written");
+    let f = jointquake::testcase::write_case(&c, &dir).unwrap();
+    let m = jointquake::mesh::Mesh::from_msh(&f.msh).unwrap();
+    assert_eq!(m.nodes.len(), c.mesh.nodes.len());
+    assert_eq!(m.group("lower:z1").unwrap().cells.len(), 32);
+    assert_eq!(m.group("upper:z0").unwrap().cells.len(), 9);
+    jointquake::scene::Scene::load(&f.scene).expect("the written scene loads");
+}
