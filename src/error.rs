@@ -125,6 +125,9 @@ pub enum StudyError {
     Io { path: PathBuf, message: String },
     #[error("study {path}: {message}")]
     Invalid { path: PathBuf, message: String },
+    /// `study submit --slurm`: an option, or `sbatch`.
+    #[error("study submit --slurm: {0}")]
+    Slurm(String),
 }
 
 /// Writing results.
