@@ -107,6 +107,8 @@ for k, r in enumerate(plan["runs"]):
 PY
 grep -q "^## Cost" "$T/slurm/report.md" || fail "the report has no cost section"
 python3 scripts/slurm/compare_reports.py "$T/local/report.json" "$T/slurm/report.json" || fail "the Slurm report differs from the local one"
+echo "  cost, local: $(sed -n '/^## Cost/{n;n;p}' "$T/local/report.md")"
+echo "  cost, Slurm: $(sed -n '/^## Cost/{n;n;p}' "$T/slurm/report.md")"
 
 echo "== the cluster's results copied elsewhere report the same"
 cp -a "$T/slurm" "$T/copy"
