@@ -131,11 +131,16 @@ fn run_summary_records_host_build_and_slurm_ids_and_old_summaries_still_read() {
     let host = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap();
     assert_eq!(p["host"], host.trim());
     assert_eq!(p["version"], env!("CARGO_PKG_VERSION"));
-    let head = Command::new("git").args(["rev-parse", "HEAD"]).current_dir(env!("CARGO_MANIFEST_DIR")).output().ok().filter(|o| o.status.success()).map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
-    match head {
-        // built from this checkout (a commit made since the build would differ: build again)
-        Some(h) => assert_eq!(p["commit"], h.as_str()),
-        None => assert_eq!(p["commit"], "unknown"),
+    // built in a git checkout: a commit of this repository (HEAD at build time, which a commit
+    // made since without a rebuild would no longer be); else "unknown"
+    let git = |args: &[&str]| Command::new("git").args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().ok().filter(|o| o.status.success()).map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    let commit = p["commit"].as_str().unwrap();
+    match git(&["rev-parse", "HEAD"]) {
+        Some(_) => {
+            assert!(commit.len() == 40 && commit.bytes().all(|b| b.is_ascii_hexdigit()), "commit {commit}");
+            assert_eq!(git(&["cat-file", "-t", commit]).as_deref(), Some("commit"), "{commit} is not a commit of this repository");
+        }
+        None => assert_eq!(commit, "unknown"),
     }
     assert!(p.get("slurm").is_none(), "not under Slurm: {p}");
     assert!(String::from_utf8_lossy(&o.stdout).contains(&format!("ran on          {}", host.trim())));
