@@ -123,6 +123,14 @@ incline:
 joint-tests:
 	$(MAKE) --no-print-directory study STUDY=pipelines/joint_tests_study.json
 
+# A study on a real single-node Slurm (docs/cluster.md): installs slurm-wlm and munge if missing
+# (as root), starts slurmctld and slurmd on this machine, runs the incline study (shortened) on it
+# and locally, compares the reports, kills one array task and re-submits; stops the daemons.
+# Status 3 when Slurm cannot be started here (SLURM_CANNOT_START_OK=1: prints SKIPPED, status 0).
+.PHONY: test-slurm
+test-slurm: build
+	scripts/slurm/test.sh
+
 bench: build
 	cargo bench --bench explicit
 	cargo bench --bench tagger

@@ -130,6 +130,9 @@ pub enum StudyError {
     Io { path: PathBuf, message: String },
     #[error("study {path}: {message}")]
     Invalid { path: PathBuf, message: String },
+    /// `study submit --slurm`: an option, or `sbatch`.
+    #[error("study submit --slurm: {0}")]
+    Slurm(String),
 }
 
 /// A generated joint test case (`testcase` module): names the option to fix.

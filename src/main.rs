@@ -388,6 +388,34 @@ enum StudyCmd {
         #[arg(long)]
         threads: Option<usize>,
     },
+    /// Plan the study (as `plan`) and submit its runs to Slurm: a job array (one task per run
+    /// not done yet) and a report job after it (docs/cluster.md).
+    Submit {
+        study: PathBuf,
+        /// Submit to Slurm (`sbatch`); the only scheduler `submit` knows.
+        #[arg(long, required = true)]
+        slurm: bool,
+        /// Partition of the jobs (default: the cluster's default partition).
+        #[arg(long)]
+        partition: Option<String>,
+        /// Time limit of each run's task and of the report job, HH:MM:SS or D-HH:MM:SS (default: the partition's).
+        #[arg(long)]
+        time: Option<String>,
+        /// Cores of each run's task, and its `--threads`.
+        #[arg(long, default_value_t = 1)]
+        cpus_per_run: usize,
+        /// At most this many runs at once (the array's `%K`; default: no limit).
+        #[arg(long)]
+        max_parallel: Option<usize>,
+        /// Write the scripts and print the sbatch commands without submitting.
+        #[arg(long)]
+        dry_run: bool,
+        #[arg(long, default_value = "build/mesh")]
+        cache: PathBuf,
+        /// The jointquake binary the tasks run (default: this one; the nodes must see it).
+        #[arg(long)]
+        bin: Option<PathBuf>,
+    },
     /// Read every run and step, write `<out>/report.md`, `report.json` and `charts/`. Exits
     /// with status 1 (after writing) when runs or steps have no results, naming them.
     Report { study: PathBuf },
@@ -695,6 +723,38 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
             );
             say!("  plan      {}", files.plan.display());
             say!("  makefile  {}", files.makefile.display());
+        }
+        StudyCmd::Submit { study: path, slurm: _, partition, time, cpus_per_run, max_parallel, dry_run, cache, bin } => {
+            use jointquake::study::slurm;
+            let bin = match bin {
+                Some(b) => b,
+                None => std::env::current_exe().context("finding this jointquake binary (give --bin)")?,
+            };
+            let opts = slurm::SlurmOptions { partition, time, cpus_per_run, max_parallel, bin, cache };
+            opts.check()?;
+            let (s, kind) = load(&path)?;
+            study::write_plan(&s, &kind.steps(), &opts.cache, &opts.bin.display().to_string()).with_context(|| format!("planning study {}", path.display()))?;
+            let plan = study::Plan::read(&s.out)?;
+            let sub = slurm::write_scripts(&plan, &opts).with_context(|| format!("writing the Slurm scripts of study {}", path.display()))?;
+            say!("study {} ({}): {} of {} runs to do{}", s.name, s.kind, sub.todo.len(), sub.total, sub.array.as_ref().map(|a| format!(" (array {a})")).unwrap_or_default());
+            for (k, id, why) in &sub.todo {
+                say!("  task {k:>4}  {id} ({why})");
+            }
+            say!("  array job   {}", sub.runs_script.display());
+            say!("  report job  {}", sub.collect_script.display());
+            if dry_run {
+                say!("dry run: submit with");
+                for c in slurm::commands(&sub) {
+                    say!("  {c}");
+                }
+            } else {
+                let j = slurm::submit(&plan, &sub).with_context(|| format!("submitting study {}", path.display()))?;
+                match &j.array_job {
+                    Some(a) => say!("submitted: array job {a} ({} tasks), report job {} after it", sub.todo.len(), j.report_job),
+                    None => say!("submitted: report job {} (every run is done)", j.report_job),
+                }
+                say!("  follow with `squeue --me`; report: {}", plan.out.join("report.md").display());
+            }
         }
         StudyCmd::Step { study: path, name, cache, threads } => {
             let threads = threads.map(capped_threads).transpose()?;

@@ -202,6 +202,7 @@ impl Recorder {
             notes: sim.notes.clone(),
             timings,
             wall_time,
+            provenance: Some(crate::output::summary::Provenance::of_this_process()),
         }
     }
 }

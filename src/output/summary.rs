@@ -53,6 +53,57 @@ pub struct RunSummary {
     /// Stage wall times [s].
     pub timings: Vec<(String, f64)>,
     pub wall_time: f64,
+    /// Where and how the run ran (host, jointquake version and commit, Slurm ids); with
+    /// `threads` and `wall_time` above, what a study's cost is summed from. `None` in summaries
+    /// written before jointquake recorded it.
+    #[serde(default)]
+    pub provenance: Option<Provenance>,
+}
+
+/// Where and how a run ran (`summary.json` → `provenance`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Provenance {
+    /// Host name of the machine (`/proc/sys/kernel/hostname`, else `$HOSTNAME`, else "unknown").
+    pub host: String,
+    /// jointquake's version (Cargo.toml).
+    pub version: String,
+    /// The git commit jointquake was built from (`git rev-parse HEAD` at build time, build.rs),
+    /// "unknown" when built outside a git checkout.
+    pub commit: String,
+    /// The Slurm job that ran it, when run under Slurm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slurm: Option<SlurmIds>,
+}
+
+/// Slurm's ids of the job running this process (from its environment).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SlurmIds {
+    /// `SLURM_JOB_ID`.
+    pub job_id: String,
+    /// `SLURM_ARRAY_JOB_ID` and `SLURM_ARRAY_TASK_ID` for a task of a job array.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array_job_id: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array_task_id: Option<String>,
+}
+
+impl Provenance {
+    /// The provenance of this process: its host, this build, and Slurm's ids if any.
+    pub fn of_this_process() -> Provenance {
+        let env = |k: &str| std::env::var(k).ok().map(|v| v.trim().to_string()).filter(|v| !v.is_empty());
+        let host = std::fs::read_to_string("/proc/sys/kernel/hostname").ok().map(|h| h.trim().to_string()).filter(|h| !h.is_empty()).or_else(|| env("HOSTNAME")).unwrap_or_else(|| "unknown".into());
+        let slurm = env("SLURM_JOB_ID").map(|job_id| SlurmIds { job_id, array_job_id: env("SLURM_ARRAY_JOB_ID"), array_task_id: env("SLURM_ARRAY_TASK_ID") });
+        Provenance { host, version: env!("CARGO_PKG_VERSION").to_string(), commit: env!("JQ_GIT_COMMIT").to_string(), slurm }
+    }
+
+    /// `host`, with `Slurm job <array job>_<task>` (or `<job>`) when it ran under Slurm.
+    pub fn place(&self) -> String {
+        match &self.slurm {
+            Some(SlurmIds { array_job_id: Some(a), array_task_id: Some(t), .. }) => format!("{} (Slurm job {a}_{t})", self.host),
+            Some(s) => format!("{} (Slurm job {})", self.host, s.job_id),
+            None => self.host.clone(),
+        }
+    }
 }
 
 impl RunSummary {
@@ -116,6 +167,9 @@ impl RunSummary {
         }
         let t: Vec<String> = self.timings.iter().map(|(k, v)| format!("{k} {v:.2} s")).collect();
         let _ = writeln!(s, "  wall time       {:.2} s ({})", self.wall_time, t.join(", "));
+        if let Some(p) = &self.provenance {
+            let _ = writeln!(s, "  ran on          {} with jointquake {} (commit {})", p.place(), p.version, p.commit);
+        }
         let _ = writeln!(s, "results in {}", self.out_dir.display());
         if let Some(p) = &self.pvd {
             let _ = writeln!(s, "  ParaView series {} ({} frames)", p.display(), self.frames);

@@ -318,7 +318,32 @@ impl Plan {
     pub fn read(out: &Path) -> Result<Plan, OutputError> {
         let p = out.join("plan.json");
         let text = std::fs::read_to_string(&p).map_err(|e| OutputError::read(&p, format!("{e} (run `jointquake study plan` first)")))?;
-        serde_json::from_str(&text).map_err(|e| OutputError::read(&p, format!("not a study plan: {e} (re-run `jointquake study plan`)")))
+        let plan: Plan = serde_json::from_str(&text).map_err(|e| OutputError::read(&p, format!("not a study plan: {e} (re-run `jointquake study plan`)")))?;
+        Ok(plan.moved_to(&absolute(out)))
+    }
+
+    /// The plan with its output directory at `out`: the paths under the directory it was
+    /// planned in are moved along, so that a result directory copied elsewhere (from a
+    /// cluster to a laptop) reads as it was written.
+    fn moved_to(mut self, out: &Path) -> Plan {
+        if self.out == out {
+            return self;
+        }
+        let from = std::mem::replace(&mut self.out, out.to_path_buf());
+        let move_path = |p: &mut PathBuf| {
+            if let Ok(rel) = p.strip_prefix(&from) {
+                *p = out.join(rel);
+            }
+        };
+        for r in &mut self.runs {
+            move_path(&mut r.scene);
+            move_path(&mut r.dir);
+        }
+        for s in &mut self.steps {
+            move_path(&mut s.output);
+            move_path(&mut s.log);
+        }
+        self
     }
 }
 
@@ -343,7 +368,7 @@ fn write_if_changed(path: &Path, text: &str) -> Result<bool, OutputError> {
 }
 
 /// Make-safe form of a path (spaces would split a target).
-fn mk_path(p: &Path) -> Result<String, Error> {
+pub(crate) fn mk_path(p: &Path) -> Result<String, Error> {
     let s = p.display().to_string();
     if s.contains(' ') || s.contains('$') || s.contains(':') {
         return Err(ModelError::Invalid(format!("{s}: the generated Makefile cannot name a path with spaces, `$` or `:`; move the study or its output")).into());
@@ -402,11 +427,10 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
         t.push_str(&format!(" $(OUT)/.{}.done", s.name));
     }
     t.push_str("\n\n$(OUT)/runs/%/.done: $(OUT)/scenes/%.json\n");
-    t.push_str("\t@mkdir -p $(OUT)/runs/$*\n");
-    t.push_str("\t@rm -f $(OUT)/runs/$*/failed.txt $(OUT)/runs/$*/summary.json\n");
-    t.push_str("\t@echo \"run $*\"\n");
-    t.push_str("\t@$(BIN) run $< --out $(OUT)/runs/$* --cache $(CACHE) --threads 1 --quiet > $(OUT)/runs/$*.log 2>&1 || { grep '^error' $(OUT)/runs/$*.log > $(OUT)/runs/$*/failed.txt || tail -n 5 $(OUT)/runs/$*.log > $(OUT)/runs/$*/failed.txt; echo \"run $* FAILED: $$(cat $(OUT)/runs/$*/failed.txt)\"; }\n");
-    t.push_str("\t@touch $@\n");
+    let vars = RecipeVars { bin: "$(BIN)", out: "$(OUT)", id: "$*", cache: "$(CACHE)", threads: "1", dollar: "$$" };
+    for line in run_recipe(&vars) {
+        t.push_str(&format!("\t@{line}\n"));
+    }
     for (s, spec) in plan.steps.iter().zip(steps) {
         let output = mk_path(&s.output)?;
         t.push_str(&format!("\n$(OUT)/.{n}.done: $(STUDY) {scene}\n", n = s.name, scene = mk_path(&absolute(&study.scene))?));
@@ -419,4 +443,77 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
     }
     write_if_changed(&mk, &t)?;
     Ok(PlanFiles { plan: plan_path, makefile: mk, scenes, changed, meshes })
+}
+
+/// Where the commands of [`run_recipe`] find their parts: shell words (a path checked by the
+/// caller, or a variable of the Makefile or script that runs them).
+pub struct RecipeVars<'a> {
+    /// The jointquake binary.
+    pub bin: &'a str,
+    /// The study's output directory.
+    pub out: &'a str,
+    /// The run id.
+    pub id: &'a str,
+    /// The mesh cache.
+    pub cache: &'a str,
+    /// `--threads` of the run.
+    pub threads: &'a str,
+    /// What the shell's `$` is written as: `$$` in a Makefile, `$` in a script.
+    pub dollar: &'a str,
+}
+
+/// The shell commands that run one planned run and record its outcome, one per line: the
+/// recipe of a run in `runs.mk` and the body of a Slurm array task (`study submit`), written
+/// once. The run's terminal output goes to `<out>/runs/<id>.log`; a run that stops with an
+/// error leaves `failed.txt` (the error line, else the log's tail) and does not fail the
+/// recipe; `.done` is touched last, so a run killed before it ends (Ctrl-C, `scancel`) is redone.
+pub fn run_recipe(v: &RecipeVars) -> Vec<String> {
+    let RecipeVars { bin, out, id, cache, threads, dollar } = v;
+    let dir = format!("{out}/runs/{id}");
+    let log = format!("{out}/runs/{id}.log");
+    vec![
+        format!("mkdir -p {dir}"),
+        format!("rm -f {dir}/failed.txt {dir}/summary.json {dir}/.done"),
+        format!("echo \"run {id}\""),
+        format!(
+            "{bin} run {out}/scenes/{id}.json --out {dir} --cache {cache} --threads {threads} --quiet > {log} 2>&1 || {{ grep '^error' {log} > {dir}/failed.txt || tail -n 5 {log} > {dir}/failed.txt; echo \"run {id} FAILED: {dollar}(cat {dir}/failed.txt)\"; }}"
+        ),
+        format!("touch {dir}/.done"),
+    ]
+}
+
+/// Whether a planned run is done, by the rule `runs.mk` gives `make` for the target
+/// `runs/<id>/.done` made from `scenes/<id>.json`: not done while `.done` is missing, stale
+/// when the scene is newer than it. Written once for what does not go through `make`: the
+/// report (`results`) and `study submit` (which tasks a re-submit runs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RunFreshness {
+    /// `.done` is there and not older than the scene: the run ended (finished or failed).
+    Done,
+    /// No `.done`: never run, still running, or killed before it ended.
+    NotDone,
+    /// `.done` is older than the scene: the scene changed after the run.
+    Stale,
+}
+
+impl PlannedRun {
+    /// The run's `.done` marker (touched when its recipe ends).
+    pub fn done_marker(&self) -> PathBuf {
+        self.dir.join(".done")
+    }
+
+    /// The run's terminal output (`<out>/runs/<id>.log`).
+    pub fn log(&self) -> PathBuf {
+        self.dir.with_file_name(format!("{}.log", self.spec.id))
+    }
+
+    /// [`RunFreshness`] of the run now.
+    pub fn freshness(&self) -> RunFreshness {
+        let mtime = |f: &Path| std::fs::metadata(f).and_then(|m| m.modified()).ok();
+        match (mtime(&self.done_marker()), mtime(&self.scene)) {
+            (None, _) => RunFreshness::NotDone,
+            (Some(d), Some(s)) if d < s => RunFreshness::Stale,
+            _ => RunFreshness::Done,
+        }
+    }
 }

@@ -8,7 +8,7 @@
 //! by run, instead of a zero or a NaN.
 
 use super::file::Study;
-use super::plan::{load_base, Plan, PlannedRun, PlannedStep, RunSpec};
+use super::plan::{load_base, Plan, PlannedRun, PlannedStep, RunFreshness, RunSpec};
 use super::{KindReport, StudyKind};
 use crate::error::{Error, OutputError};
 use crate::output::history::HistoryTable;
@@ -17,7 +17,7 @@ use crate::report::Table;
 use crate::scene::Scene;
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// What became of a run.
 #[derive(Clone, Debug, Serialize)]
@@ -70,22 +70,28 @@ impl RunResult {
     }
 
     fn read(p: &PlannedRun) -> RunResult {
-        let mtime = |f: &Path| std::fs::metadata(f).and_then(|m| m.modified()).ok();
         let scene = Scene::load(&p.scene);
-        let done = p.dir.join(".done");
         let failed = p.dir.join("failed.txt");
         let summary = p.dir.join("summary.json");
+        let log = p.log();
         let (scene, mut status) = match scene {
             Ok(s) => (Some(s), RunStatus::Finished),
             Err(e) => (None, RunStatus::Missing(format!("its scene cannot be read: {e} (re-run `jointquake study plan`)"))),
         };
         let mut sum = None;
         if matches!(status, RunStatus::Finished) {
-            status = match (mtime(&done), mtime(&p.scene)) {
-                (None, _) if !summary.exists() && !failed.exists() => RunStatus::Missing(format!("not run (no results in {})", p.dir.display())),
-                (Some(d), Some(s)) if d < s => RunStatus::Missing("stale: its scene changed after it ran".into()),
+            status = match p.freshness() {
+                RunFreshness::NotDone if !summary.exists() && !failed.exists() => RunStatus::Missing(if log.exists() {
+                    format!("not finished: started (log {}) but no results yet in {}: still running, or killed (out of time or memory)", log.display(), p.dir.display())
+                } else {
+                    format!("not run (no results in {})", p.dir.display())
+                }),
+                RunFreshness::Stale => RunStatus::Missing("stale: its scene changed after it ran".into()),
                 _ => match std::fs::read_to_string(&failed) {
-                    Ok(t) => RunStatus::Failed(t.trim().trim_start_matches("error: ").to_string()),
+                    Ok(t) => {
+                        let e = t.trim().trim_start_matches("error: ").to_string();
+                        RunStatus::Failed(if log.exists() && !e.contains(&*log.to_string_lossy()) { format!("{e} (log {})", log.display()) } else { e })
+                    }
                     Err(_) => match RunSummary::read(&summary) {
                         Ok(s) => {
                             sum = Some(s);
@@ -202,6 +208,10 @@ pub fn write_report(study: &Study, kind: &dyn StudyKind) -> Result<ReportFiles, 
             let _ = writeln!(markdown, "- `{id}`: {why}");
         }
     }
+    let cost = StudyCost::of(&results.runs);
+    if cost.runs > 0 {
+        let _ = writeln!(markdown, "\n## Cost\n\n{}", cost.to_text());
+    }
     let out = &results.plan.out;
     let report = out.join("report.md");
     crate::report::file::write_atomic(&report, markdown.as_bytes())?;
@@ -211,11 +221,68 @@ pub fn write_report(study: &Study, kind: &dyn StudyKind) -> Result<ReportFiles, 
         "kind": results.plan.kind,
         "runs": status,
         "problems": problems,
+        "cost": cost,
         "report": json,
     });
     let jpath = out.join("report.json");
     crate::report::file::write_atomic(&jpath, serde_json::to_string_pretty(&doc).expect("the report serialises").as_bytes())?;
     Ok(ReportFiles { report, json: jpath, charts, lines, problems })
+}
+
+/// What a study's finished runs cost, from their summaries (`wall_time`, `threads`,
+/// `provenance`): `report.json` → `cost` and the report's "Cost" section.
+#[derive(Clone, Debug, Serialize)]
+pub struct StudyCost {
+    /// Finished runs counted.
+    pub runs: usize,
+    /// Sum of their wall times [s].
+    pub wall_time: f64,
+    /// Sum of wall time × threads [core-s].
+    pub core_time: f64,
+    /// The longest run's wall time [s].
+    pub longest: f64,
+    /// Where they ran, and the jointquake builds (version and commit), each once.
+    pub hosts: Vec<String>,
+    pub builds: Vec<String>,
+}
+
+impl StudyCost {
+    pub fn of(runs: &[RunResult]) -> StudyCost {
+        let mut c = StudyCost { runs: 0, wall_time: 0.0, core_time: 0.0, longest: 0.0, hosts: Vec::new(), builds: Vec::new() };
+        for s in runs.iter().filter_map(|r| r.summary.as_ref()) {
+            c.runs += 1;
+            c.wall_time += s.wall_time;
+            c.core_time += s.wall_time * s.threads as f64;
+            c.longest = c.longest.max(s.wall_time);
+            let (host, build) = match &s.provenance {
+                Some(p) => (p.host.clone(), format!("{} ({})", p.version, p.commit)),
+                None => ("not recorded".to_string(), "not recorded".to_string()),
+            };
+            if !c.hosts.contains(&host) {
+                c.hosts.push(host);
+            }
+            if !c.builds.contains(&build) {
+                c.builds.push(build);
+            }
+        }
+        c
+    }
+
+    /// One paragraph for the report.
+    pub fn to_text(&self) -> String {
+        let f = |x: f64| crate::report::fmt_sig(x, 4);
+        format!(
+            "{} finished run{}: {} s of wall time in all ({} core-seconds: wall time × threads; {} h), the longest {} s; on {}; jointquake {}.",
+            self.runs,
+            if self.runs == 1 { "" } else { "s" },
+            f(self.wall_time),
+            f(self.core_time),
+            f(self.core_time / 3600.0),
+            f(self.longest),
+            self.hosts.join(", "),
+            self.builds.join(", ")
+        )
+    }
 }
 
 /// The table every study can show: each run's status, size, step, wall time and joint maxima.
