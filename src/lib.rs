@@ -45,6 +45,7 @@ pub mod gmsh;
 pub mod interface;
 pub mod linalg;
 pub mod mesh;
+pub mod bonded;
 pub mod modes;
 pub mod model;
 pub mod motion;
