@@ -37,6 +37,7 @@
 //! drive too. Module dependencies point down (no import loop): `docs/architecture.md`.
 
 pub mod constraint;
+pub mod construction;
 pub mod contact;
 pub mod dynamics;
 pub mod error;

@@ -408,9 +408,10 @@ fn real_main() -> Result<()> {
             say_raw!("{}", summary.to_text());
         }
         Cmd::Modes { scene, count, out, cache, json } => {
-            let s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
+            let mut s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
             let opts = RunOptions { mesh_cache: Some(cache), ..Default::default() };
             let mesh = jointquake::pipeline::load_mesh(&s, &opts).with_context(|| format!("meshing scene {}", scene.display()))?;
+            jointquake::pipeline::expand_patterns(&mut s, &mesh, &scene)?;
             let out_dir = out.unwrap_or_else(|| s.output_dir());
             let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
             let r = jointquake::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;

@@ -2,7 +2,8 @@
 //!
 //! K of every element (the massless blocks included, so their unknowns are condensed by the
 //! eigen-solver itself: M is singular there, see `linalg::eigen`), M the inertial mass with the
-//! reservoir's added-mass blocks, on the free dofs. Outputs: a table (frequency [Hz], period
+//! reservoir's added-mass blocks, on the free dofs. The layer of a massless block along a joint
+//! (mass without weight, kept only for the explicit contact force) is massless here too. Outputs: a table (frequency [Hz], period
 //! [s], ω² [1/s²], participation factor Γ_d = φᵀ M ι_d and effective modal mass Γ_d² [kg] along
 //! x, y, z with φ M-normalised, and that mass as a fraction of the total mass the ground moves
 //! along d) and `modes/modes.pvd`: one VTU per mode (ParaView "time" = mode number) with the
@@ -73,7 +74,10 @@ pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesRep
     let blocks: Vec<(usize, [[f64; 3]; 3])> =
         model.mass.blocks.iter().map(|b| (b.node as usize, std::array::from_fn(|i| std::array::from_fn(|j| b.added[(i, j)])))).collect();
     let (all, na) = dof_map(n, |_| true);
-    let mff = t.reduce(&mass_matrix(&model.mass.inertial, &blocks, &all, na));
+    // the massless foundation is massless here: the layer a massless block keeps along a joint
+    // (mass without weight, for the explicit contact force) has no part in the modes
+    let inertia: Vec<f64> = model.mass.inertial.iter().zip(&model.weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect();
+    let mff = t.reduce(&mass_matrix(&inertia, &blocks, &all, na));
     let with_mass = (0..nf).filter(|&j| mff.get(j, j) > 0.0).count();
     let m = lowest_modes(&kff, &mff, &ModesOptions { count, ..Default::default() }).map_err(|e| ModelError::Invalid(e.to_string()))?;
     // influence vectors (a unit translation of the reduced unknowns is one of the whole model:

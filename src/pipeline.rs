@@ -76,7 +76,7 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
-        sim.equilibrate()?;
+        crate::construction::equilibrate(&mut sim)?;
         laps.lap("equilibrium");
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
         let mut recorder = Recorder::create(&sim, &out_dir, opts.progress)?;
