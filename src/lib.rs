@@ -39,6 +39,7 @@
 pub mod constraint;
 pub mod construction;
 pub mod contact;
+pub mod dam_static;
 pub mod dynamics;
 pub mod error;
 pub mod foundation;
