@@ -80,7 +80,7 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
     let problem = Problem::build(scene, mesh)?;
     laps.lap("model");
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
-    let mut simulate = || -> Result<RunSummary, Error> {
+    let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
         crate::construction::equilibrate(&mut sim)?;
         laps.lap("equilibrium");
