@@ -118,9 +118,9 @@ wedge-report:
 # the static state with the construction sequence and the modes empty and full, joints bonded.
 dam-static: venv build
 	$(BIN) tag pipelines/dam.json --out out/dam_static
-	$(BIN) dam-static pipelines/dam.json --out out/dam_static
 	$(BIN) modes pipelines/dam.json -n 6 --out out/dam_static/full
 	$(BIN) modes pipelines/dam_empty.json -n 6 --out out/dam_static/empty
+	$(BIN) dam-static pipelines/dam.json --out out/dam_static
 	@echo
 	@echo "ParaView: out/dam_static/dam.pvd (the static state: stress, principal_stress, displacement),"
 	@echo "          out/dam_static/joints/J01.pvd ... J28.pvd, base.pvd (opening, normal_traction),"
