@@ -19,7 +19,7 @@ JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests
+.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests dam-static
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -114,6 +114,19 @@ wedge-report:
 
 # The El Centro incline (docs/studies.md): friction angle 35°/40° × PGA 0.25/0.5/0.75 g on the
 # committed incline fixture against the rigid Newmark block (6 runs of about 12 s; out/incline).
+# The arch dam (docs/dam.md): mesh geo/arch_dam.geo (defaults), tag the 28 joints and the base,
+# the static state with the construction sequence and the modes empty and full, joints bonded.
+dam-static: venv build
+	$(BIN) tag pipelines/dam.json --out out/dam_static
+	$(BIN) modes pipelines/dam.json -n 6 --out out/dam_static/full
+	$(BIN) modes pipelines/dam_empty.json -n 6 --out out/dam_static/empty
+	$(BIN) dam-static pipelines/dam.json --out out/dam_static
+	@echo
+	@echo "ParaView: out/dam_static/dam.pvd (the static state: stress, principal_stress, displacement),"
+	@echo "          out/dam_static/joints/J01.pvd ... J28.pvd, base.pvd (opening, normal_traction),"
+	@echo "          out/dam_static/full/modes/modes.pvd, out/dam_static/empty/modes/modes.pvd (mode shapes)."
+	@echo "Table: out/dam_static/static_table.md; tagging: out/dam_static/tagging/; modes: */modes/modes.json."
+
 incline:
 	$(MAKE) --no-print-directory study STUDY=pipelines/incline_study.json
 

@@ -37,7 +37,9 @@
 //! drive too. Module dependencies point down (no import loop): `docs/architecture.md`.
 
 pub mod constraint;
+pub mod construction;
 pub mod contact;
+pub mod dam_static;
 pub mod dynamics;
 pub mod error;
 pub mod foundation;
@@ -45,6 +47,7 @@ pub mod gmsh;
 pub mod interface;
 pub mod linalg;
 pub mod mesh;
+pub mod bonded;
 pub mod modes;
 pub mod model;
 pub mod motion;

@@ -98,6 +98,21 @@ enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// The arch dam's static state (docs/dam.md): the scene's static sequence
+    /// (`equilibrium.sequence`, e.g. "construction"), written as a zero-length run (frames with
+    /// stress, principal stresses, displacement; joint surfaces with opening and normal traction)
+    /// plus the table of crest radial displacements and crown stresses (<out>/static_table.md,
+    /// .json). Needs the groups of geo/arch_dam.geo.
+    DamStatic {
+        /// Scene file (JSON, see docs/scenes.md).
+        scene: PathBuf,
+        /// Output directory (default: the scene's output.dir, else out/<name>).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Mesh cache directory.
+        #[arg(long, default_value = "build/mesh")]
+        cache: PathBuf,
+    },
     /// Tag the joints of a scene (slave/master, normals, Layer1/Layer2, NTN pairs) and write
     /// <out>/tagging/joints.json, one <joint>.vtu per joint and summary.json.
     ///
@@ -504,9 +519,10 @@ fn real_main() -> Result<()> {
             say_raw!("{}", summary.to_text());
         }
         Cmd::Modes { scene, count, out, cache, json } => {
-            let s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
+            let mut s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
             let opts = RunOptions { mesh_cache: Some(cache), ..Default::default() };
             let mesh = jointquake::pipeline::load_mesh(&s, &opts).with_context(|| format!("meshing scene {}", scene.display()))?;
+            jointquake::pipeline::expand_patterns(&mut s, &mesh, &scene)?;
             let out_dir = out.unwrap_or_else(|| s.output_dir());
             let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
             let r = jointquake::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;
@@ -514,6 +530,26 @@ fn real_main() -> Result<()> {
                 say!("{}", serde_json::to_string_pretty(&r).context("serialising the modes")?);
             } else {
                 say_raw!("{}", r.to_text());
+            }
+        }
+        Cmd::DamStatic { scene, out, cache } => {
+            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
+            let mut table_md = None;
+            let mut inspect = |sim: &jointquake::simulation::Simulation<'_>, dir: &std::path::Path| -> Result<(), jointquake::Error> {
+                let t = jointquake::dam_static::static_table(&sim.problem.model, &sim.state.u)?;
+                std::fs::create_dir_all(dir).map_err(|e| jointquake::error::OutputError::write(dir, e))?;
+                let md = dir.join("static_table.md");
+                std::fs::write(&md, t.to_markdown()).map_err(|e| jointquake::error::OutputError::write(&md, e))?;
+                let js = dir.join("static_table.json");
+                std::fs::write(&js, serde_json::to_string_pretty(&t).expect("serialises")).map_err(|e| jointquake::error::OutputError::write(&js, e))?;
+                table_md = Some((t.to_markdown(), md));
+                Ok(())
+            };
+            let summary = jointquake::pipeline::run_inspect(&scene, &opts, &mut inspect).with_context(|| format!("static state of scene {}", scene.display()))?;
+            say_raw!("{}", summary.to_text());
+            if let Some((md, path)) = table_md {
+                say!("{md}");
+                say!("static table: {}", path.display());
             }
         }
         Cmd::Tag { scene, out, cache, json } => {

@@ -2,17 +2,22 @@
 //!
 //! K of every element (the massless blocks included, so their unknowns are condensed by the
 //! eigen-solver itself: M is singular there, see `linalg::eigen`), M the inertial mass with the
-//! reservoir's added-mass blocks, on the free dofs. Outputs: a table (frequency [Hz], period
+//! reservoir's added-mass blocks, on the free dofs. The layer of a massless block along a joint
+//! (mass without weight, kept only for the explicit contact force) is massless here too. Outputs: a table (frequency [Hz], period
 //! [s], ω² [1/s²], participation factor Γ_d = φᵀ M ι_d and effective modal mass Γ_d² [kg] along
 //! x, y, z with φ M-normalised, and that mass as a fraction of the total mass the ground moves
 //! along d) and `modes/modes.pvd`: one VTU per mode (ParaView "time" = mode number) with the
 //! point field `mode_shape` scaled to a largest nodal displacement of 1 (Warp By Vector).
 //!
-//! Joints are not bonded in this version: a scene with `joints` is refused with that message
-//! (bond conforming blocks by sharing nodes, or remove the joints for the modal analysis).
+//! Joints are **bonded** (`bonded`): every slave node moves with its master point on the
+//! initial configuration, an exact linear constraint eliminated by u = T û, so K̂ = Tᵀ K T and
+//! M̂ = Tᵀ M T (the slave's mass and added mass go to its masters). Contact laws (friction,
+//! opening) play no part: the modes are those of the grouted, bonded structure, the usual
+//! linear reference of dam practice. The shapes are written on every node (u = T φ̂).
 
 use crate::error::{Error, ModelError};
-use crate::linalg::{dof_map, lowest_modes, mass_matrix, restrict, stiffness, ModesOptions, NONE};
+use crate::bonded::{Bonding, TieInfo};
+use crate::linalg::{dof_map, lowest_modes, mass_matrix, stiffness, ModesOptions};
 use crate::problem::Problem;
 use crate::vtk::pvd::PvdSeries;
 use crate::vtk::vtu::{write_vtu, Field, Grid};
@@ -43,6 +48,8 @@ pub struct ModesReport {
     pub dofs: usize,
     /// Free dofs that carry mass (the rest are condensed).
     pub dofs_with_mass: usize,
+    /// How the joints' slave nodes were bonded (all zero without joints).
+    pub ties: TieInfo,
     pub lanczos_steps: usize,
     /// ι_dᵀ M ι_d along x, y, z [kg].
     pub total_mass: [f64; 3],
@@ -54,28 +61,28 @@ pub struct ModesReport {
 /// The `count` lowest modes of `problem`, with the shapes written under `out_dir/modes/`.
 pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesReport, Error> {
     let t0 = std::time::Instant::now();
-    if !problem.joints.is_empty() {
-        return Err(ModelError::Invalid(format!(
-            "modes: the scene has {} joint(s); bonding non-conforming joints in the modal analysis is not in this version. Remove `joints` (or mesh the bonded blocks conforming) for `jointquake modes`",
-            problem.joints.len()
-        ))
-        .into());
-    }
     if count == 0 {
         return Err(ModelError::Invalid("modes: -n must be at least 1".into()).into());
     }
     let model = &problem.model;
     let n = 3 * model.n_nodes();
     let k = stiffness(model, &vec![true; model.materials.len()]);
-    let (map, nf) = dof_map(n, |d| model.is_free(d / 3, d % 3) && k.col_ptr[d + 1] > k.col_ptr[d]);
-    let kff = restrict(&k, &map, nf, &map, nf);
+    let bonded: Vec<&crate::contact::joint::ContactJoint> = problem.joints.iter().collect();
+    let t = Bonding::build(model, &bonded, |d| model.is_free(d / 3, d % 3) && k.col_ptr[d + 1] > k.col_ptr[d])?;
+    let nf = t.n;
+    let kff = t.reduce(&k);
     let blocks: Vec<(usize, [[f64; 3]; 3])> =
         model.mass.blocks.iter().map(|b| (b.node as usize, std::array::from_fn(|i| std::array::from_fn(|j| b.added[(i, j)])))).collect();
-    let mff = mass_matrix(&model.mass.inertial, &blocks, &map, nf);
+    let (all, na) = dof_map(n, |_| true);
+    // the massless foundation is massless here: the layer a massless block keeps along a joint
+    // (mass without weight, for the explicit contact force) has no part in the modes
+    let inertia: Vec<f64> = model.mass.inertial.iter().zip(&model.weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect();
+    let mff = t.reduce(&mass_matrix(&inertia, &blocks, &all, na));
     let with_mass = (0..nf).filter(|&j| mff.get(j, j) > 0.0).count();
     let m = lowest_modes(&kff, &mff, &ModesOptions { count, ..Default::default() }).map_err(|e| ModelError::Invalid(e.to_string()))?;
-    // influence vectors and total masses
-    let iota: Vec<Vec<f64>> = (0..3).map(|c| (0..n).filter(|&d| map[d] != NONE).map(|d| if d % 3 == c { 1.0 } else { 0.0 }).collect()).collect();
+    // influence vectors (a unit translation of the reduced unknowns is one of the whole model:
+    // the weights of a master point sum to 1) and total masses
+    let iota: Vec<Vec<f64>> = (0..3).map(|c| { let mut v = vec![0.0; nf]; for d in (c..n).step_by(3) { if t.map[d] != crate::linalg::NONE { v[t.map[d]] = 1.0; } } v }).collect();
     let mut mi = vec![vec![0.0; nf]; 3];
     for c in 0..3 {
         mff.mul_into(&iota[c], &mut mi[c]);
@@ -100,12 +107,7 @@ pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesRep
             effective_fraction: std::array::from_fn(|c| if total_mass[c] > 0.0 { gamma[c] * gamma[c] / total_mass[c] } else { 0.0 }),
             residual: m.residual[i],
         });
-        full.fill(0.0);
-        for d in 0..n {
-            if map[d] != NONE {
-                full[d] = phi[map[d]];
-            }
-        }
+        t.expand_into(phi, &mut full);
         let umax = full.chunks(3).map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()).fold(0.0, f64::max);
         if umax > 0.0 {
             full.iter_mut().for_each(|v| *v /= umax);
@@ -118,6 +120,7 @@ pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesRep
         scene: problem.scene.name().to_string(),
         dofs: nf,
         dofs_with_mass: with_mass,
+        ties: t.info.clone(),
         lanczos_steps: m.lanczos_steps,
         total_mass,
         modes: rows,
@@ -139,6 +142,14 @@ impl ModesReport {
             "scene {}: {} free dofs ({} with mass; the others condensed), {} Lanczos vectors, {:.2} s",
             self.scene, self.dofs, self.dofs_with_mass, self.lanczos_steps, self.wall_time
         );
+        if self.ties.joints > 0 {
+            let t = &self.ties;
+            let _ = writeln!(
+                s,
+                "{} joint(s) bonded: {} slave nodes tied to their master points ({} projected, {} within half a face, {} to the nearest master node; {} already tied by an earlier joint)",
+                t.joints, t.tied, t.projected, t.widened, t.nearest_node, t.already_tied
+            );
+        }
         let _ = writeln!(s, "total mass moved by the ground: x {:.4e} kg, y {:.4e} kg, z {:.4e} kg", self.total_mass[0], self.total_mass[1], self.total_mass[2]);
         let _ = writeln!(s, "{:>4} {:>11} {:>10} {:>11} {:>11} {:>11} {:>7} {:>7} {:>7}", "mode", "f [Hz]", "T [s]", "Meff_x [kg]", "Meff_y [kg]", "Meff_z [kg]", "x [%]", "y [%]", "z [%]");
         let mut cum = [0.0; 3];

@@ -58,6 +58,12 @@ pub fn expand_patterns(scene: &mut Scene, mesh: &Mesh, scene_path: &Path) -> Res
 
 /// Run a scene file end to end: the recipe.
 pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
+    run_inspect(scene_path, opts, &mut |_, _| Ok(()))
+}
+
+/// [`run`], with `inspect` called on the simulation and the output directory after the static
+/// state (the equilibrium), before the dynamic stage (e.g. the dam's static table).
+pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMut(&Simulation<'_>, &Path) -> Result<(), Error> + Send)) -> Result<RunSummary, Error> {
     let t_all = Instant::now();
     let mut laps = Laps::start();
     let mut scene = Scene::load(scene_path)?;
@@ -76,9 +82,10 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
-        sim.equilibrate()?;
+        crate::construction::equilibrate(&mut sim)?;
         laps.lap("equilibrium");
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
+        inspect(&sim, &out_dir)?;
         let mut recorder = Recorder::create(&sim, &out_dir, opts.progress)?;
         sim.run(&mut recorder)?;
         laps.lap("dynamic");

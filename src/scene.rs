@@ -429,6 +429,17 @@ pub struct EquilibriumSpec {
     /// "brittle": the joints' own law applies during relaxation too.
     #[serde(default = "default_joint_bonds")]
     pub joint_bonds: String,
+    /// How the static loads meet the joints (module `construction`): "simultaneous" (default:
+    /// gravity and the reservoir at once, the joints in contact with their gaps as meshed),
+    /// "grouted" (the same, the joints grouted first: zero gap where their sides are at the
+    /// start), "construction" (self-weight with the joints that are not `tied` open, then
+    /// grouting at the deformed state, then the reservoir with the joints active).
+    #[serde(default = "default_sequence")]
+    pub sequence: String,
+}
+
+fn default_sequence() -> String {
+    "simultaneous".into()
 }
 
 fn default_joint_bonds() -> String {
@@ -450,7 +461,7 @@ fn default_eq_steps() -> usize {
 
 impl Default for EquilibriumSpec {
     fn default() -> Self {
-        EquilibriumSpec { method: relaxation(), tolerance: default_eq_tol(), max_residual: default_eq_max_res(), max_steps: default_eq_steps(), joint_bonds: default_joint_bonds() }
+        EquilibriumSpec { method: relaxation(), tolerance: default_eq_tol(), max_residual: default_eq_max_res(), max_steps: default_eq_steps(), joint_bonds: default_joint_bonds(), sequence: default_sequence() }
     }
 }
 
@@ -871,6 +882,9 @@ impl Scene {
         }
         if !matches!(self.equilibrium.joint_bonds.as_str(), "kept" | "brittle") {
             return Err(format!("equilibrium.joint_bonds \"{}\" is not \"kept\" or \"brittle\"", self.equilibrium.joint_bonds));
+        }
+        if !matches!(self.equilibrium.sequence.as_str(), "simultaneous" | "grouted" | "construction") {
+            return Err(format!("equilibrium.sequence \"{}\" is not \"simultaneous\", \"grouted\" or \"construction\"", self.equilibrium.sequence));
         }
         if !matches!(self.equilibrium.method.as_str(), "relaxation" | "none") {
             return Err(format!("equilibrium.method \"{}\" is not \"relaxation\" or \"none\"", self.equilibrium.method));

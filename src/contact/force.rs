@@ -675,7 +675,7 @@ impl ContactSolver<'_> {
                         xbar += pos(model, conf, mi) * weights[a];
                         um_n += disp(u, mi) * weights[a];
                     }
-                    let gap = n.dot(&(xbar - xs));
+                    let gap = n.dot(&(xbar - xs)) - rec.pairs[i].gap_offset;
                     // explicit penalty at t[n]: tangential increment over the last step
                     let mut um_p = Vector3::zeros();
                     for a in 0..nm as usize {
@@ -731,7 +731,8 @@ impl ContactSolver<'_> {
                     frame: j.frames[i],
                     area: j.tag.areas[i],
                     hist0: pr.hist,
-                    gap0: n.dot(&xbar0),
+                    // the grouted gap counts as closed (0 unless grouted)
+                    gap0: n.dot(&xbar0) - pr.gap_offset,
                     rel_u,
                     joint: ji as u32,
                     pair: i as u32,

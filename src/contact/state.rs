@@ -24,6 +24,10 @@ pub struct PairRecord {
     pub d_t: [f64; 2],
     /// Accumulated tangential relative path Σ|Δd_t| [m] (the joint's slip).
     pub slip: f64,
+    /// Gap that counts as closed [m], subtracted from the geometric gap: 0 (the gaps as meshed)
+    /// unless the joint was grouted, where it is the gap at grouting (a construction
+    /// sequence's stage, `construction`), so the grouted joint starts closed with no force.
+    pub gap_offset: f64,
 }
 
 /// Counters of search events per joint.
@@ -84,6 +88,7 @@ impl ContactState {
                             r_t: [0.0; 2],
                             d_t: [0.0; 2],
                             slip: 0.0,
+                            gap_offset: 0.0,
                         })
                         .collect(),
                     ..Default::default()

@@ -19,6 +19,7 @@
 //! `energy_tolerance` × the energy scale) or unbounded growth stops the run.
 
 pub mod loads;
+pub mod staged;
 pub mod record;
 pub mod time;
 

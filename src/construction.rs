@@ -1,0 +1,199 @@
+//! The static state of a jointed structure as it is built (scene `equilibrium.sequence`).
+//!
+//! - `"simultaneous"` (default): gravity and the static forces (the reservoir) brought to
+//!   equilibrium together with every joint in contact, gaps as meshed
+//!   (`simulation::Simulation::equilibrate`).
+//! - `"grouted"`: the same, after the joints are grouted on the initial configuration.
+//! - `"construction"`, as concrete dams are built (design.md §7):
+//!   (a) **self-weight with the joints ungrouted**: the joints that are not `tied` carry
+//!   nothing (open, no shear: each monolith is an independent cantilever), the `tied` ones (the
+//!   dam–rock base) are bonded. This stage is linear, so it is solved directly: K̂ û = Tᵀ F_g
+//!   with the tied joints eliminated (`bonded`: u_s = Σ N_I u_I), the massless foundation
+//!   in K (so condensed exactly), one sparse Cholesky. Residual ‖Tᵀ (F − K u)‖ / ‖Tᵀ F‖.
+//!   (b) **grouting**: every joint that is not tied closes at the deformed state, with the gap
+//!   measured there (`PairRecord::gap_offset` = the gap along the slave normal to the deformed
+//!   master surface), so it starts closed with no force and keeps its own law (Mohr–Coulomb).
+//!   (c) **the static forces** (the reservoir's hydrostatic pressure) ramped in by dynamic
+//!   relaxation with the joints active and gravity kept (`dynamics::staged`).
+//!
+//! Grouting: a joint is grouted pair by pair; a slave node that finds no master face (even
+//! within half a face) keeps offset 0 and is counted.
+//!
+//! Each stage's residual and method are in the returned [`SequenceReport`] and the run's notes.
+
+use crate::bonded::Bonding;
+use crate::constraint::Constraint;
+use crate::contact::joint::ContactJoint;
+use crate::contact::query::select_projection;
+use crate::contact::ContactState;
+use crate::dynamics::staged::relax_static_increment;
+use crate::dynamics::EquilibriumInfo;
+use crate::error::{Error, ModelError};
+use crate::linalg::{stiffness, SparseCholesky};
+use crate::problem::Problem;
+use crate::simulation::Simulation;
+use nalgebra::Vector3;
+
+/// One stage of the sequence.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct StageReport {
+    pub name: String,
+    /// "direct solve", "relaxation", "grouting".
+    pub method: String,
+    /// Relative residual at the end of the stage (0 for grouting).
+    pub residual: f64,
+    /// Relaxation steps (0 for a direct solve).
+    pub steps: usize,
+    pub note: String,
+}
+
+/// The stages of a static sequence, in order.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SequenceReport {
+    pub sequence: String,
+    pub stages: Vec<StageReport>,
+}
+
+impl SequenceReport {
+    /// One line per stage.
+    pub fn lines(&self) -> Vec<String> {
+        self.stages.iter().map(|s| format!("static sequence \"{}\", stage {}: {}, residual {:.2e}{}{}", self.sequence, s.name, s.method, s.residual, if s.steps > 0 { format!(", {} steps", s.steps) } else { String::new() }, if s.note.is_empty() { String::new() } else { format!("; {}", s.note) })).collect()
+    }
+}
+
+/// The linear static solution u of K u = F with the joints `bonded` tied (the others carry
+/// nothing), and its residual ‖Tᵀ (F − K u)‖ / ‖Tᵀ F‖.
+pub fn linear_static(problem: &Problem, bonded: &[&ContactJoint], f: &[f64]) -> Result<(Vec<f64>, f64, Bonding), Error> {
+    let model = &problem.model;
+    let k = stiffness(model, &vec![true; model.materials.len()]);
+    let t = Bonding::build(model, bonded, |d| model.is_free(d / 3, d % 3) && k.col_ptr[d + 1] > k.col_ptr[d])?;
+    let kh = t.reduce(&k);
+    let fh = t.reduce_vector(f);
+    let mut chol = SparseCholesky::factor(&kh, "static stage", faer::Par::Seq).map_err(|e| ModelError::Invalid(e.to_string()))?;
+    let mut uh = fh.clone();
+    chol.solve_in_place(&mut uh);
+    let mut u = vec![0.0; t.n_dofs];
+    t.expand_into(&uh, &mut u);
+    let mut ku = vec![0.0; t.n_dofs];
+    k.mul_into(&u, &mut ku);
+    let r: Vec<f64> = f.iter().zip(&ku).map(|(a, b)| a - b).collect();
+    let rh = t.reduce_vector(&r);
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let nf = norm(&fh);
+    let residual = if nf > 0.0 { norm(&rh) / nf } else { 0.0 };
+    Ok((u, residual, t))
+}
+
+/// Stage (a): self-weight with the joints that are not tied open, the tied ones bonded.
+/// Returns u and the stage's report.
+pub fn self_weight_open_joints(problem: &Problem) -> Result<(Vec<f64>, StageReport), Error> {
+    let model = &problem.model;
+    let mut gravity_only = problem.loads.clone();
+    gravity_only.static_forces.clear();
+    let mut f = vec![0.0; 3 * model.n_nodes()];
+    gravity_only.external_force_into(model, 0.0, true, false, &mut f);
+    let tied: Vec<&ContactJoint> = problem.joints.iter().filter(|j| j.law.tied).collect();
+    let (u, residual, t) = linear_static(problem, &tied, &f)?;
+    let note = format!("{} tied joint(s) bonded ({} slave nodes), {} joint(s) open", tied.len(), t.info.tied, problem.joints.len() - tied.len());
+    Ok((u, StageReport { name: "a: self-weight, joints ungrouted".into(), method: "direct solve".into(), residual, steps: 0, note }))
+}
+
+/// Stage (b): grout every joint that is not tied at the displacements `u`: each pair's gap
+/// offset becomes its gap there. Returns the stage's report (largest |offset|, pairs without
+/// a master face).
+pub fn grout(problem: &Problem, contact: &mut ContactState, u: &[f64]) -> Result<StageReport, Error> {
+    let model = &problem.model;
+    let (mut pairs, mut missed, mut largest) = (0usize, 0usize, 0.0f64);
+    for (ji, j) in problem.joints.iter().enumerate() {
+        if j.law.tied {
+            continue;
+        }
+        let m = &j.tag.master;
+        let pos = |node: usize| Vector3::new(model.mesh.nodes[node][0] + u[3 * node], model.mesh.nodes[node][1] + u[3 * node + 1], model.mesh.nodes[node][2] + u[3 * node + 2]);
+        for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
+            let xs = pos(s);
+            let n = j.frames[i][0];
+            let faces: Vec<(usize, Vec<Vector3<f64>>)> = j.tag.layer2.row(i).iter().map(|&f| (f as usize, m.faces[f as usize].nodes().iter().map(|&nd| pos(nd as usize)).collect())).collect();
+            let project = |tol: f64| select_projection(&xs, &n, faces.iter().map(|(f, x)| (*f, x.as_slice())), tol).map_err(|e| ModelError::Invalid(format!("grouting joint \"{}\": {e}", j.tag.name)));
+            let hit = match project(j.edge_tolerance)? {
+                Some(h) => Some(h),
+                None => project(0.5)?,
+            };
+            let rec = &mut contact.joints[ji].pairs[i];
+            match hit {
+                Some((_, p)) => {
+                    rec.gap_offset = p.gap;
+                    largest = largest.max(p.gap.abs());
+                    pairs += 1;
+                }
+                None => missed += 1,
+            }
+        }
+    }
+    let note = format!("{pairs} pairs grouted (largest |gap| closed {largest:.3e} m){}", if missed > 0 { format!(", {missed} slave nodes without a master face left as meshed") } else { String::new() });
+    Ok(StageReport { name: "b: grouting".into(), method: "grouting".into(), residual: 0.0, steps: 0, note })
+}
+
+/// The static state of `sim` as its scene's `equilibrium.sequence` says, then the clock and
+/// the slip counters restart (as `Simulation::equilibrate`). The stage lines go to the notes.
+pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
+    let p = sim.problem;
+    let sc = &p.scene;
+    let sequence = sc.equilibrium.sequence.clone();
+    let mut stages = Vec::new();
+    let relaxing = sc.equilibrium.method == "relaxation" && (p.loads.gravity.is_some() || !p.loads.static_forces.is_empty());
+    match sequence.as_str() {
+        "construction" if relaxing => {
+            let (u, a) = self_weight_open_joints(p)?;
+            sim.state.u.copy_from_slice(&u);
+            sim.state.u_prev.copy_from_slice(&u);
+            stages.push(a);
+            stages.push(grout(p, &mut sim.state.contact, &u)?);
+            if let Some(c) = sim.contact.as_mut() {
+                c.keep_bonds = sc.equilibrium.joint_bonds == "kept";
+            }
+            let eq = {
+                let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(2);
+                if let Some(c) = sim.contact.as_mut() {
+                    cs.push(c);
+                }
+                if let Some(f) = sim.foundation.as_mut() {
+                    cs.push(f);
+                }
+                relax_static_increment(&p.model, &p.loads, &mut sim.solver, &mut sim.state, &mut cs, sc.equilibrium.tolerance, sc.equilibrium.max_steps)?
+            };
+            if let Some(c) = sim.contact.as_mut() {
+                c.keep_bonds = false;
+            }
+            if !eq.converged && eq.residual > sc.equilibrium.max_residual {
+                return Err(ModelError::Invalid(format!(
+                    "static sequence, stage c (static forces with the joints active): equilibrium not reached in {} steps, residual {:.2e} > max_residual {:.1e}. Raise equilibrium.max_steps",
+                    eq.steps, eq.residual, sc.equilibrium.max_residual
+                ))
+                .into());
+            }
+            stages.push(StageReport {
+                name: "c: static forces (reservoir), joints active".into(),
+                method: "relaxation".into(),
+                residual: eq.residual,
+                steps: eq.steps,
+                note: if eq.converged { String::new() } else { format!("above tolerance {:.1e} (accepted below max_residual)", sc.equilibrium.tolerance) },
+            });
+            sim.restart_clock();
+            sim.state.contact.restart_slip();
+            sim.equilibrium = Some(EquilibriumInfo { steps: eq.steps, residual: eq.residual, converged: eq.converged });
+        }
+        _ => {
+            if sequence == "grouted" {
+                let zero = vec![0.0; sim.state.u.len()];
+                stages.push(grout(p, &mut sim.state.contact, &zero)?);
+            }
+            if let Some(eq) = sim.equilibrate()? {
+                stages.push(StageReport { name: "all loads, joints in contact".into(), method: "relaxation".into(), residual: eq.residual, steps: eq.steps, note: String::new() });
+            }
+        }
+    }
+    let report = SequenceReport { sequence, stages };
+    sim.notes.extend(report.lines());
+    Ok(report)
+}

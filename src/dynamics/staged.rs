@@ -1,0 +1,84 @@
+//! Dynamic relaxation of a load increment on a state already in equilibrium (the stages of a
+//! construction sequence, module `construction`).
+//!
+//! The same scheme as [`super::relax_gravity`] (undamped mass, α = 2 ω_min from the Rayleigh
+//! quotient, the constraints after each prediction), with gravity kept at its full value from
+//! the first step (the state already carries it) and only the static forces (the reservoir's
+//! hydrostatic pressure) ramped in over [`super::RELAXATION_RAMP_STEPS`] steps. Residual:
+//! ‖M (a + α v_b)‖ over the free components, relative to ‖F_gravity + F_static‖ (the whole load
+//! the state must now carry).
+
+use super::{Constraints, EquilibriumInfo, ExplicitSolver, Stage, State, RELAXATION_RAMP_STEPS};
+use crate::dynamics::loads::Loads;
+use crate::error::StepError;
+use crate::model::Model;
+
+/// Relax `state` (in equilibrium under gravity alone) to equilibrium under gravity plus the
+/// static forces of `loads`, ramped in; `tol` and `max_steps` as for relaxation.
+pub fn relax_static_increment(
+    model: &Model,
+    loads: &Loads,
+    solver: &mut ExplicitSolver,
+    state: &mut State,
+    constraints: Constraints<'_, '_>,
+    tol: f64,
+    max_steps: usize,
+) -> Result<EquilibriumInfo, StepError> {
+    let mut f_all = vec![0.0; 3 * model.n_nodes()];
+    loads.external_force_into(model, 0.0, true, false, &mut f_all);
+    let norm_f: f64 = f_all.iter().enumerate().filter(|(i, _)| model.is_free(i / 3, i % 3)).map(|(_, f)| f * f).sum::<f64>().sqrt();
+    if norm_f == 0.0 || loads.static_forces.is_empty() {
+        return Ok(EquilibriumInfo { steps: 0, residual: 0.0, converged: true });
+    }
+    let mut stage = loads.clone();
+    let dt = solver.dt;
+    let mut residual = f64::INFINITY;
+    let mut alpha = 0.0;
+    for k in 0..max_steps {
+        let scale = ((k + 1) as f64 / RELAXATION_RAMP_STEPS as f64).min(1.0);
+        for (s, f) in stage.static_forces.iter_mut().zip(&loads.static_forces) {
+            s.1 = f.1.map(|v| v * scale);
+        }
+        solver.step(model, &stage, state, Stage::Relaxation(alpha, 1.0), &mut *constraints)?;
+        let mut r2 = 0.0;
+        let (mut ukb, mut umu) = (0.0, 0.0);
+        let f_int = solver.internal_force();
+        for i in 0..state.u.len() {
+            if model.is_free(i / 3, i % 3) {
+                let m = model.mass.inertial[i / 3];
+                let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
+                let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
+                let r = m * (a + alpha * vb);
+                r2 += r * r;
+                ukb += state.u_prev[i] * f_int[i];
+                umu += m * state.u_prev[i] * state.u_prev[i];
+            }
+        }
+        for b in &model.mass.blocks {
+            let i0 = 3 * b.node as usize;
+            let mut av = nalgebra::Vector3::zeros();
+            for c in 0..3 {
+                let i = i0 + c;
+                if model.is_free(i / 3, c) {
+                    let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
+                    let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
+                    let r = model.mass.inertial[i / 3] * (a + alpha * vb);
+                    r2 -= r * r;
+                    av[c] = a + alpha * vb;
+                }
+            }
+            let r = b.full * av;
+            r2 += (0..3).filter(|&c| model.is_free(b.node as usize, c)).map(|c| r[c] * r[c]).sum::<f64>();
+        }
+        residual = r2.max(0.0).sqrt() / norm_f;
+        if umu > 0.0 && ukb > 0.0 {
+            alpha = (2.0 * (ukb / umu).sqrt()).min(0.5 / dt);
+        }
+        if residual < tol && k + 1 >= RELAXATION_RAMP_STEPS {
+            state.u_prev.copy_from_slice(&state.u);
+            return Ok(EquilibriumInfo { steps: k + 1, residual, converged: true });
+        }
+    }
+    state.u_prev.copy_from_slice(&state.u);
+    Ok(EquilibriumInfo { steps: max_steps, residual, converged: false })
+}
