@@ -1,10 +1,19 @@
 //! The run's recorder: what a run writes and watches while it steps (an observer of a
 //! [`Simulation`]).
 //!
-//! - **Schedule**: a history row every `output.history_stride` steps (monitors and joints), a
-//!   frame every `output.frame_stride` steps, or every `frame_interval` seconds, or about 100
-//!   frames over the run; the last step always writes a frame. A run of no steps writes the
+//! - **Clock**: every output (history row, volume frame, joint frame) carries the state at the
+//!   time it is stamped with, t[m] = m dt for output index m = 0 … N (N = duration / dt): the
+//!   monitors and volume frames from the kinematics after step m (u[m−1], u[m], u[m+1]), the
+//!   joints from the contact state after step m − 1 (the state at t[m]; at m = 0 the
+//!   equilibrium). The last row and frame are at t[N] = duration.
+//! - **Schedule**: a history row every `output.history_stride` steps or `history_interval`
+//!   seconds (default [`DEFAULT_HISTORY_INTERVAL`], at least [`MIN_HISTORY_ROWS`] rows over the
+//!   run), a frame every `output.frame_stride` steps, or every `frame_interval` seconds, or
+//!   about 100 frames over the run; t[0] and t[N] always get both. A run of no steps writes the
 //!   equilibrium state as its one frame.
+//! - **Interruption**: Ctrl-C or SIGTERM ([`install_interrupt_handler`]) ends the run at the
+//!   next output index: its row and frames are written whole and the summary says
+//!   `interrupted`.
 //! - **Monitors**: the scene's points snapped to nodes ([`snap_monitors`]).
 //! - **Peaks**: |u|, |v|, |a| of any node, sampled every [`PEAK_STRIDE`] steps and at the last.
 //! - **Progress**: a bar on stderr when asked for and stderr is a terminal; nothing otherwise.
@@ -31,6 +40,45 @@ use std::path::{Path, PathBuf};
 /// about a step's nodal update; one in ten keeps it under 10 % and still samples a 10 Hz
 /// response 40 times a period at the wedge's dt (2.6e-4 s).
 pub const PEAK_STRIDE: usize = 10;
+
+/// Default time between two history rows [s] when the scene gives neither `history_stride` nor
+/// `history_interval`: 1 ms, 1000 rows a second, 10 samples a period at 100 Hz (beyond the
+/// content of any earthquake record) at about 200 B a row for a monitor (250 B for a joint):
+/// 2 MB per monitor for a 10 s run, whatever its step (every step wrote 1.37 GB for a 5 M-step
+/// run).
+pub const DEFAULT_HISTORY_INTERVAL: f64 = 1e-3;
+
+/// With the default interval, a run gets at least this many rows (short runs: impacts, waves):
+/// the interval is min(1 ms, duration / 1000), never below one step.
+pub const MIN_HISTORY_ROWS: f64 = 1000.0;
+
+/// Set by Ctrl-C / SIGTERM / SIGHUP once [`install_interrupt_handler`] ran.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Make Ctrl-C, SIGTERM and SIGHUP end a run cleanly: the first prints one line and the run
+/// stops at its next output (row and frames written, `summary.json` marked `interrupted`); a
+/// second quits at once (exit status 130). For the CLI; call once.
+pub fn install_interrupt_handler() -> Result<(), String> {
+    ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("interrupted: finishing the current output and writing summary.json (press Ctrl-C again to quit at once)");
+    })
+    .map_err(|e| format!("cannot install the Ctrl-C handler: {e}"))
+}
+
+/// The steps between two history rows for `spec` at step `dt` over `duration` [s].
+pub fn history_stride(spec: &crate::scene::OutputSpec, dt: f64, duration: f64) -> usize {
+    match (spec.history_stride, spec.history_interval) {
+        (Some(k), _) => k.max(1),
+        (None, Some(hi)) => ((hi / dt).round() as usize).max(1),
+        (None, None) => {
+            let hi = DEFAULT_HISTORY_INTERVAL.min(duration / MIN_HISTORY_ROWS);
+            ((hi / dt).floor() as usize).max(1)
+        }
+    }
+}
 
 /// Snap monitored points to nodes (optionally of a group; else the nearest node with inertia).
 pub fn snap_monitors(model: &Model, scene: &Scene) -> Result<Vec<Monitor>, Error> {
@@ -104,6 +152,8 @@ pub struct Recorder {
     hist_stride: usize,
     rows: Vec<[f64; 9]>,
     bar: indicatif::ProgressBar,
+    /// The last output index after an interruption.
+    stop: Option<usize>,
 }
 
 impl Recorder {
@@ -150,9 +200,10 @@ impl Recorder {
             joints,
             peaks: Peaks::default(),
             frame_stride,
-            hist_stride: scene.output.history_stride.max(1),
+            hist_stride: history_stride(&scene.output, dt, scene.time.duration),
             rows,
             bar,
+            stop: None,
         })
     }
 
@@ -202,56 +253,92 @@ impl Recorder {
             notes: sim.notes.clone(),
             timings,
             wall_time,
+            interrupted: self.stop.map(|m| m as f64 * sim.dt()),
+            history_rows_every: self.hist_stride as f64 * sim.dt(),
+            warnings: Vec::new(),
         }
+    }
+
+    /// Whether output index `m` gets a history row (`last`: the run's last index).
+    fn history_due(&self, m: usize, last: usize) -> bool {
+        m % self.hist_stride == 0 || m == last
+    }
+
+    /// Whether output index `m` gets a frame.
+    fn frame_due(&self, m: usize, last: usize) -> bool {
+        m % self.frame_stride == 0 || m == last
     }
 }
 
 impl Observer for Recorder {
     fn start(&mut self, sim: &Simulation<'_>) -> Result<(), Error> {
+        let p = sim.problem;
         if sim.n_steps() > 0 {
+            // the joints at t[0]: the equilibrium's contact state (the volume's t[0] comes with
+            // the first step, which gives its velocity)
+            if let Some(jw) = self.joints.as_mut() {
+                jw.unsearched = sim.equilibrium.is_none();
+                jw.record(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
+                jw.write_frame(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
+                jw.unsearched = false;
+            }
             return Ok(());
         }
         // `duration: 0` runs only the equilibrium: write that state (at rest) as the one frame
-        let p = sim.problem;
         let kin = sim.kinematics_at_rest();
         let kin = Kinematics { t: 0.0, ..kin };
         for (r, m) in self.rows.iter_mut().zip(&self.monitors) {
             r[..3].copy_from_slice(&kin.u[3 * m.node..3 * m.node + 3]);
         }
-        self.history.row(0.0, &self.rows)?;
+        self.history.row(0.0, &self.rows);
+        self.history.flush()?;
         if let Some(f) = self.frames.as_mut() {
             f.write(&p.model, &kin)?;
         }
         if let Some(jw) = self.joints.as_mut() {
-            jw.record(0.0, &p.joints, &sim.state.contact)?;
+            jw.unsearched = sim.equilibrium.is_none();
+            jw.record(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
             jw.write_frame(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
+            jw.unsearched = false;
         }
         Ok(())
     }
 
-    fn observe(&mut self, sim: &Simulation<'_>, k: usize, n_steps: usize) -> Result<(), Error> {
+    fn observe(&mut self, sim: &Simulation<'_>, k: usize, last: usize) -> Result<(), Error> {
         let p = sim.problem;
         let state = &sim.state;
-        // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt
-        let kin = sim.kinematics();
-        if k % self.hist_stride == 0 {
-            self.monitor_rows(&kin);
-            self.history.row(kin.t, &self.rows)?;
-            if let Some(jw) = self.joints.as_mut() {
-                jw.record(state.t, &p.joints, &state.contact)?;
-            }
+        let dt = sim.dt();
+        if self.stop.is_none() && k < last && INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+            self.stop = Some(k + 1);
         }
-        if k % PEAK_STRIDE == 0 || k + 1 == n_steps {
+        let last = self.stop.map_or(last, |s| s.min(last));
+        // the step just taken gives u[k−1], u[k], u[k+1]: the volume and monitors at t[k]
+        let kin = Kinematics { t: k as f64 * dt, ..sim.kinematics() };
+        if self.history_due(k, last) {
+            self.monitor_rows(&kin);
+            self.history.row(kin.t, &self.rows);
+        }
+        if k % PEAK_STRIDE == 0 || k == last {
             self.peaks.update(&p.model, &kin);
         }
-        if k % self.frame_stride == 0 || k + 1 == n_steps {
+        if self.frame_due(k, last) {
             if let Some(f) = self.frames.as_mut() {
                 f.write(&p.model, &kin)?;
             }
-            if let Some(jw) = self.joints.as_mut() {
-                jw.write_frame(state.t, &p.joints, &state.contact, &state.u)?;
-            }
             self.history.flush()?;
+        }
+        // ... and the contact state at t[k + 1], with u[k+1]
+        if k < last {
+            let t1 = (k + 1) as f64 * dt;
+            let (row, frame) = (self.history_due(k + 1, last), self.frame_due(k + 1, last));
+            if let Some(jw) = self.joints.as_mut() {
+                if row {
+                    jw.record(t1, &p.joints, &state.contact, &state.u)?;
+                }
+                if frame {
+                    jw.write_frame(t1, &p.joints, &state.contact, &state.u)?;
+                }
+            }
         }
         if k % 64 == 0 {
             self.bar.set_position(k as u64);
@@ -260,11 +347,14 @@ impl Observer for Recorder {
         Ok(())
     }
 
+    fn stop_after(&self) -> Option<usize> {
+        self.stop
+    }
+
     fn finish(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
         self.bar.finish_and_clear();
         self.history.flush()?;
         if let Some(jw) = self.joints.as_mut() {
-            // the last step already wrote its frame (k + 1 == n_steps in `observe`)
             jw.flush()?;
         }
         Ok(())

@@ -53,6 +53,17 @@ pub struct RunSummary {
     /// Stage wall times [s].
     pub timings: Vec<(String, f64)>,
     pub wall_time: f64,
+    /// Set when Ctrl-C / SIGTERM ended the run early: the time of its last output [s] (the
+    /// outputs up to there are whole).
+    #[serde(default)]
+    pub interrupted: Option<f64>,
+    /// Time between two history rows [s] (`output.history_stride` / `history_interval`).
+    #[serde(default)]
+    pub history_rows_every: f64,
+    /// What the run got through but should not be trusted without a look (lost contact, an
+    /// unconverged Gauss–Seidel, NTN on a non-conforming joint): also printed on the terminal.
+    #[serde(default)]
+    pub warnings: Vec<String>,
 }
 
 impl RunSummary {
@@ -113,6 +124,12 @@ impl RunSummary {
         }
         for n in &self.notes {
             let _ = writeln!(s, "  note            {n}");
+        }
+        for w in &self.warnings {
+            let _ = writeln!(s, "  WARNING         {w}");
+        }
+        if let Some(t) = self.interrupted {
+            let _ = writeln!(s, "  INTERRUPTED     at t = {t:.6} s of {} s (outputs whole up to there)", self.duration);
         }
         let t: Vec<String> = self.timings.iter().map(|(k, v)| format!("{k} {v:.2} s")).collect();
         let _ = writeln!(s, "  wall time       {:.2} s ({})", self.wall_time, t.join(", "));
