@@ -1,4 +1,4 @@
-//! Writing VTU (VTK XML unstructured grid) files with `vtkio`.
+//! Writing VTU (VTK XML unstructured grid) files.
 //!
 //! One generic writer serves the volume frames, the joint surfaces and the tagger's
 //! inspection files. Files are written to `<name>.tmp` and renamed, so a reader (or a
@@ -8,8 +8,8 @@
 //! (`compressor="vtkZLibDataCompressor"`, `header_type="UInt64"`), in VTK's layout: per array a
 //! header [blocks = 1, block size, last block size, compressed size] base64-encoded on its own,
 //! then the zlib stream. vtkio's model writer puts only one size before the stream (ParaView and
-//! meshio cannot read that), so the XML is written here and vtkio only compresses
-//! ([`IOBuffer::into_bytes_with_size`]). Sizes and write times against the former uncompressed
+//! meshio cannot read that) and feeds zlib one byte per call (10x slower), so the XML is
+//! written here, with `flate2` (vtkio's own zlib). Sizes and write times against the former uncompressed
 //! files: docs/performance.md §7.
 //! Labels of categorical arrays go into the grid's `FieldData` as one-value Int32 arrays
 //! ([`write_vtu_labelled`]).
@@ -18,8 +18,6 @@ use crate::error::OutputError;
 use crate::mesh::CellKind;
 use std::path::Path;
 use std::fmt::Write as _;
-use vtkio::model::{ByteOrder, IOBuffer};
-use vtkio::xml::Compressor;
 
 /// A named array of `ncomp` components per point or per cell.
 pub struct Field<'a> {
@@ -74,29 +72,42 @@ fn base64_into(bytes: &[u8], out: &mut String) {
     }
 }
 
-/// One `<DataArray>` of `buf`, zlib-compressed in VTK's block layout (one block).
-fn data_array_into(out: &mut String, vtk_type: &str, name: Option<&str>, ncomp: usize, buf: IOBuffer) {
-    let raw = buf.num_bytes() as u64;
+/// One `<DataArray>` of the little-endian bytes `raw`, zlib-compressed in VTK's block layout
+/// (one block).
+fn data_array_into(out: &mut String, vtk_type: &str, name: Option<&str>, ncomp: usize, raw: &[u8]) {
+    use std::io::Write as _;
     let _ = write!(out, "<DataArray type=\"{vtk_type}\"");
     if let Some(n) = name {
         let _ = write!(out, " Name=\"{n}\"");
     }
     let _ = write!(out, " NumberOfComponents=\"{ncomp}\" format=\"binary\">");
-    // vtkio gives [compressed size (u64)][zlib stream]
-    let z = buf.into_bytes_with_size(ByteOrder::LittleEndian, Compressor::ZLib, ZLIB_LEVEL);
-    let stream = &z[8..];
-    let header: Vec<u8> = if raw == 0 { [0u64, 0, 0] .iter().flat_map(|v| v.to_le_bytes()).collect() } else { [1u64, raw, raw, stream.len() as u64].iter().flat_map(|v| v.to_le_bytes()).collect() };
-    base64_into(&header, out);
-    if raw > 0 {
-        base64_into(stream, out);
+    let n = raw.len() as u64;
+    if n == 0 {
+        base64_into(&[0u8; 24], out);
+    } else {
+        let mut z = flate2::write::ZlibEncoder::new(Vec::with_capacity(raw.len() / 4), flate2::Compression::new(ZLIB_LEVEL));
+        z.write_all(raw).expect("writing to memory");
+        let stream = z.finish().expect("writing to memory");
+        let header: Vec<u8> = [1u64, n, n, stream.len() as u64].iter().flat_map(|v| v.to_le_bytes()).collect();
+        base64_into(&header, out);
+        base64_into(&stream, out);
     }
     out.push_str("</DataArray>\n");
 }
 
+/// Little-endian bytes of `v`.
+fn le_bytes<T: Copy, const N: usize>(v: &[T], to: impl Fn(T) -> [u8; N]) -> Vec<u8> {
+    let mut b = Vec::with_capacity(v.len() * N);
+    for &x in v {
+        b.extend_from_slice(&to(x));
+    }
+    b
+}
+
 fn field_into(out: &mut String, f: &Field) {
     match f.data {
-        FieldData::F64(d) => data_array_into(out, "Float64", Some(f.name), f.ncomp, IOBuffer::F64(d.to_vec())),
-        FieldData::I32(d) => data_array_into(out, "Int32", Some(f.name), f.ncomp, IOBuffer::I32(d.to_vec())),
+        FieldData::F64(d) => data_array_into(out, "Float64", Some(f.name), f.ncomp, &le_bytes(d, f64::to_le_bytes)),
+        FieldData::I32(d) => data_array_into(out, "Int32", Some(f.name), f.ncomp, &le_bytes(d, i32::to_le_bytes)),
     }
 }
 
@@ -154,11 +165,12 @@ pub fn write_vtu_labelled(path: &Path, grid: &Grid, point_fields: &[Field], cell
         field_into(&mut x, f);
     }
     x.push_str("</CellData>\n<Points>\n");
-    data_array_into(&mut x, "Float64", None, 3, IOBuffer::F64(grid.points.iter().flatten().copied().collect()));
+    let points: Vec<f64> = grid.points.iter().flatten().copied().collect();
+    data_array_into(&mut x, "Float64", None, 3, &le_bytes(&points, f64::to_le_bytes));
     x.push_str("</Points>\n<Cells>\n");
-    data_array_into(&mut x, "Int64", Some("connectivity"), 1, IOBuffer::I64(connectivity));
-    data_array_into(&mut x, "Int64", Some("offsets"), 1, IOBuffer::I64(offsets));
-    data_array_into(&mut x, "UInt8", Some("types"), 1, IOBuffer::U8(types));
+    data_array_into(&mut x, "Int64", Some("connectivity"), 1, &le_bytes(&connectivity, i64::to_le_bytes));
+    data_array_into(&mut x, "Int64", Some("offsets"), 1, &le_bytes(&offsets, i64::to_le_bytes));
+    data_array_into(&mut x, "UInt8", Some("types"), 1, &types);
     x.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     let tmp = path.with_extension("vtu.tmp");
     std::fs::write(&tmp, x).map_err(|e| OutputError::write(&tmp, e))?;

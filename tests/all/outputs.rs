@@ -459,10 +459,12 @@ fn progress_bar_on_a_terminal_unless_quiet() {
 
 /// Issue 19 §1 (histories on the same clock): a history row stamped t carries the state at t,
 /// and the last row is the state at t[N] = N dt. Reference: a free block under gravity g from rest
-/// (no supports, `equilibrium: none`) falls as u_z = −½ g t², v_z = −g t, a_z = −g; central
-/// differences from rest reproduce these exactly (u[n] = ½ a (n dt)²), so every row must match
-/// to round-off (1e-9 relative to the fall at the end). Before the fix the last row was at
-/// t[N − 1] and the joint rows one step ahead of the monitors'.
+/// (no supports, `equilibrium: none`) under the scheme's start u[−1] = u[0] = 0 (rest at
+/// t = −dt/2) has the exact discrete solution u[n] = −½ g t_n (t_n + dt), v[n] = −g (t_n + dt/2),
+/// a[n] = −g (t_n = n dt), so every row must match it to round-off (1e-9 relative to the fall at
+/// the end); a row one step off (u[n∓1] stamped t_n) misses by g t dt, above 1e-3 of the fall.
+/// Before the fix the last row was at t[N − 1] and the joint rows one step ahead of the
+/// monitors'.
 #[test]
 fn histories_on_the_same_clock_last_row_is_the_state_at_step_n() {
     let dir = scratch("outputs/same_clock");
@@ -486,14 +488,15 @@ fn histories_on_the_same_clock_last_row_is_the_state_at_step_n() {
     assert_eq!(t.len(), n / 3 + 1 + usize::from(n % 3 != 0));
     let g = 9.81;
     let scale = 0.5 * g * (n as f64 * s.dt).powi(2);
+    let dt = s.dt;
     for i in 0..t.len() {
-        assert!((uz[i] + 0.5 * g * t[i] * t[i]).abs() < 1e-9 * scale, "row {i} at t = {}: uz {} vs {}", t[i], uz[i], -0.5 * g * t[i] * t[i]);
+        let exact = -0.5 * g * t[i] * (t[i] + dt);
+        assert!((uz[i] - exact).abs() < 1e-9 * scale, "row {i} at t = {}: uz {} vs {exact}", t[i], uz[i]);
         if i == 0 {
-            // t = 0: the scheme starts from u[−1] = u[0] (at rest), so the central differences
-            // there are g dt / 4 and g / 2, not the exact 0 and g
+            // t = 0: u[−1] = u[0] is the start, not a solution value (v, a there are g dt / 4, g / 2)
             continue;
         }
-        assert!((vz[i] + g * t[i]).abs() < 1e-9 * g * t[t.len() - 1] + 1e-12, "row {i}: vz {}", vz[i]);
+        assert!((vz[i] + g * (t[i] + 0.5 * dt)).abs() < 1e-9 * g * t[t.len() - 1] + 1e-12, "row {i}: vz {}", vz[i]);
         assert!((az[i] + g).abs() < 1e-6 * g, "row {i}: az {}", az[i]);
     }
     // the volume series ends at t[N] too
