@@ -60,6 +60,9 @@ pub struct JointPeaks {
     /// stopped at the sweep budget; 0 when every step converged).
     #[serde(default)]
     pub max_gs_residual: f64,
+    /// Typical slave face size √(slave area / faces) [m] (the scale of the NTN warning).
+    #[serde(default)]
+    pub face_size: f64,
 }
 
 /// Header of `histories/joint_<joint>.csv`: maxima over the slave nodes [m], the pairs per
@@ -157,6 +160,7 @@ impl JointWriter {
                 master_group: j.tag.master.group.clone(),
                 slave_nodes: j.tag.n_slave(),
                 ntn_max_distance: j.tag.ntn_max_distance,
+                face_size: (j.tag.slave.area / j.tag.slave.faces.len().max(1) as f64).sqrt(),
                 ..Default::default()
             });
         }

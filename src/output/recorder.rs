@@ -52,6 +52,25 @@ pub const DEFAULT_HISTORY_INTERVAL: f64 = 1e-3;
 /// the interval is min(1 ms, duration / 1000), never below one step.
 pub const MIN_HISTORY_ROWS: f64 = 1000.0;
 
+/// A joint whose lost node-steps (no master face: no contact force) exceed this fraction of its
+/// slave node-steps gets a warning: 1 %. A lost node is force-free, so a block whose contact is
+/// lost sinks into or falls through its base with the run still "passing" (`on_exit: "report"`
+/// let a block sink 3.7 m); 1 % is far above the few edge nodes of a sliding wedge that daylight
+/// near the end of a run, and far below a face that lost its contact.
+pub const LOST_WARN_FRACTION: f64 = 0.01;
+
+/// A joint whose Gauss–Seidel stopped at `gs_max_sweeps` with a residual (largest node change
+/// of the last sweep) above this factor times its tolerance gets a warning: 10. Below it the
+/// fixed point is within one decade of the requested accuracy, which the runs at the cap (wedge,
+/// 1.5 g) reach; above it the contact forces of those steps are not converged.
+pub const GS_WARN_FACTOR: f64 = 10.0;
+
+/// An NTN joint whose largest slave-to-O distance exceeds this fraction of the slave face size
+/// gets a warning: 0.1. NTN pairs each slave node with one master point O fixed at tagging; on a
+/// non-conforming mesh the offset is a lever arm of the contact force (39–135 % stress error on a
+/// patch test): use NTS there.
+pub const NTN_WARN_FRACTION: f64 = 0.1;
+
 /// Set by Ctrl-C / SIGTERM / SIGHUP once [`install_interrupt_handler`] ran.
 static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
@@ -255,8 +274,41 @@ impl Recorder {
             wall_time,
             interrupted: self.stop.map(|m| m as f64 * sim.dt()),
             history_rows_every: self.hist_stride as f64 * sim.dt(),
-            warnings: Vec::new(),
+            warnings: self.warnings(sim),
         }
+    }
+
+    /// What the run got through but should not be trusted without a look: lost contact
+    /// ([`LOST_WARN_FRACTION`]), an unconverged Gauss–Seidel ([`GS_WARN_FACTOR`]), NTN on a
+    /// non-conforming joint ([`NTN_WARN_FRACTION`]).
+    fn warnings(&self, sim: &Simulation<'_>) -> Vec<String> {
+        let mut w = Vec::new();
+        let Some(jw) = self.joints.as_ref() else { return w };
+        let steps = self.stop.unwrap_or(sim.n_steps()).max(1) as f64;
+        for (pk, j) in jw.peaks.iter().zip(&sim.problem.joints) {
+            let node_steps = pk.slave_nodes.max(1) as f64 * steps;
+            let lost = pk.events.lost as f64 / node_steps;
+            if lost > LOST_WARN_FRACTION {
+                let hint = if matches!(j.on_exit, crate::contact::joint::OnExit::Widen) { "" } else { " (on_exit \"report\": the candidate set never follows the node; use \"widen\")" };
+                w.push(format!(
+                    "joint {}: {} node-steps lost ({:.1} % of its slave node-steps, above {:.0} %): lost nodes carry no contact force, so a block can sink into or fall through its base; the largest lost travel was {:.3e} m{hint}",
+                    pk.name, pk.events.lost, 100.0 * lost, 100.0 * LOST_WARN_FRACTION, pk.max_lost_travel
+                ));
+            }
+            if pk.unconverged_steps > 0 && pk.gs_tolerance > 0.0 && pk.max_gs_residual > GS_WARN_FACTOR * pk.gs_tolerance {
+                w.push(format!(
+                    "joint {}: Gauss–Seidel stopped at gs_max_sweeps in {} steps with a residual up to {:.2e} m, {:.0} × its tolerance {:.1e} m (above {GS_WARN_FACTOR}×): the contact forces of those steps are not converged (cap: ContactSolver::gs_max_sweeps, 200 sweeps)",
+                    pk.name, pk.unconverged_steps, pk.max_gs_residual, pk.max_gs_residual / pk.gs_tolerance, pk.gs_tolerance
+                ));
+            }
+            if matches!(j.method, Method::Ntn) && pk.ntn_max_distance > NTN_WARN_FRACTION * pk.face_size {
+                w.push(format!(
+                    "joint {}: NTN on a non-conforming joint: a slave node is {:.3e} m from its master point O, {:.0} % of the face size {:.3e} m (above {:.0} %): the offset acts as a lever arm (stress errors of tens of %); use method \"nts\"",
+                    pk.name, pk.ntn_max_distance, 100.0 * pk.ntn_max_distance / pk.face_size, pk.face_size, 100.0 * NTN_WARN_FRACTION
+                ));
+            }
+        }
+        w
     }
 
     /// Whether output index `m` gets a history row (`last`: the run's last index).

@@ -111,8 +111,18 @@ impl RunSummary {
                 s,
                 "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {} (tolerance {:.1e} m){}",
                 j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps, j.gs_tolerance,
-                if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
+                if j.unconverged_steps > 0 { format!(" ({} steps unconverged, residual up to {:.1e} m)", j.unconverged_steps, j.max_gs_residual) } else { String::new() }
             );
+            if j.method == "Ntn" {
+                let _ = writeln!(
+                    s,
+                    "                 NTN: largest slave-to-O distance {:.3e} m ({:.1} % of the face size {:.3e} m); penetration is measured against O, not the master surface",
+                    j.ntn_max_distance, 100.0 * j.ntn_max_distance / j.face_size.max(f64::MIN_POSITIVE), j.face_size
+                );
+            }
+            if j.max_lost_travel > 0.0 {
+                let _ = writeln!(s, "                 lost nodes travelled up to {:.3e} m off their last master node", j.max_lost_travel);
+            }
             let e = &j.events;
             if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures + e.recentred + e.perimeter_kept > 0 {
                 let _ = writeln!(
