@@ -71,6 +71,12 @@ test: venv
 	$(BIN) run pipelines/wedge.json --out target/test-demo --duration 2 --quiet
 	$(BIN) study chart $(WEDGE_STUDY) --scene pipelines/wedge.json --run target/test-demo
 	$(PY) scripts/check_vtu.py target/test-demo
+	@echo "== ParaView itself: the demo's volume and joint series together (one time axis, arrays, one PNG)"
+	@if command -v pvpython >/dev/null && command -v xvfb-run >/dev/null; then \
+	  xvfb-run -a pvpython scripts/check_paraview.py target/test-demo target/test-demo/paraview.png; \
+	else \
+	  echo "make test: ParaView check SKIPPED: pvpython or xvfb-run not installed (Debian: apt-get install paraview python3-paraview xvfb)"; \
+	fi
 	@echo "== meshio cross-check of a scene with a joint (joint series, joint history)"
 	$(BIN) run pipelines/impact.json --out target/test-impact --quiet
 	$(PY) scripts/check_vtu.py target/test-impact

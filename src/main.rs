@@ -515,8 +515,12 @@ fn real_main() -> Result<()> {
                 rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
             }
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration, threads };
+            jointquake::output::recorder::install_interrupt_handler().map_err(anyhow::Error::msg)?;
             let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
             say_raw!("{}", summary.to_text());
+            if summary.interrupted.is_some() {
+                std::process::exit(130);
+            }
         }
         Cmd::Modes { scene, count, out, cache, json } => {
             let mut s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;

@@ -477,9 +477,14 @@ pub struct OutputSpec {
     /// A VTU frame every `frame_interval` seconds. Default: duration / 100 (about 100 frames).
     #[serde(default)]
     pub frame_interval: Option<f64>,
-    /// History rows every `history_stride` steps. Default 1.
-    #[serde(default = "one")]
-    pub history_stride: usize,
+    /// History rows every `history_stride` steps (exclusive with `history_interval`; 0 counts
+    /// as 1).
+    #[serde(default)]
+    pub history_stride: Option<usize>,
+    /// History rows every `history_interval` seconds. Default (neither given):
+    /// `output::recorder::DEFAULT_HISTORY_INTERVAL`, finer for short runs (docs/scenes.md).
+    #[serde(default)]
+    pub history_interval: Option<f64>,
     /// Monitored points, snapped to the nearest node (snap distance reported).
     #[serde(default)]
     pub monitor: Vec<MonitorSpec>,
@@ -495,16 +500,13 @@ pub struct OutputSpec {
     pub joint_forces: bool,
 }
 
-fn one() -> usize {
-    1
-}
 fn yes() -> bool {
     true
 }
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: 1, monitor: vec![], frames: true, joint_forces: false }
+        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: None, history_interval: None, monitor: vec![], frames: true, joint_forces: false }
     }
 }
 
@@ -895,6 +897,14 @@ impl Scene {
         if let Some(fi) = self.output.frame_interval {
             if !(fi > 0.0 && fi.is_finite()) {
                 return Err(format!("output.frame_interval = {fi} must be positive [s]"));
+            }
+        }
+        if self.output.history_stride.is_some() && self.output.history_interval.is_some() {
+            return Err("output: give `history_stride` or `history_interval`, not both".into());
+        }
+        if let Some(hi) = self.output.history_interval {
+            if !(hi.is_finite() && hi > 0.0) {
+                return Err(format!("output.history_interval = {hi} must be a positive time [s]"));
             }
         }
         if self.output.frame_stride == Some(0) {

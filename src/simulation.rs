@@ -15,8 +15,10 @@
 //! - `equilibrate`: the scene's `equilibrium` (relaxation of gravity with the joints' bonds kept
 //!   or not, residual checked against `max_residual`), then the clock restarts at t = 0 and
 //!   the joints' slip counters restart (slip while settling is not seismic slip).
-//! - `run`: `duration / dt` dynamic steps; after each, the observer sees u[n−1], u[n], u[n+1]
-//!   and reports at t[n] ([`Simulation::kinematics`]).
+//! - `run`: `duration / dt` = N dynamic steps and one look-ahead step: after step k the
+//!   observer sees u[k−1], u[k], u[k+1] and reports at t[k] ([`Simulation::kinematics`]), so the
+//!   outputs reach t[N] = duration with central-difference velocity and acceleration; the state
+//!   left behind is at t[N + 1]. An observer may end the run early ([`Observer::stop_after`]).
 
 use crate::constraint::Constraint;
 use crate::contact::force::ContactSolver;
@@ -33,15 +35,22 @@ pub trait Observer {
     fn start(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
         Ok(())
     }
-    /// After dynamic step `k` (0-based) of `n_steps`.
-    fn observe(&mut self, sim: &Simulation<'_>, k: usize, n_steps: usize) -> Result<(), Error>;
+    /// After dynamic step `k` (0-based): the kinematics at t[k] and the contact state at
+    /// t[k + 1]; `last` is the last output index the run will reach (the scene's N, or the
+    /// observer's [`Self::stop_after`]).
+    fn observe(&mut self, sim: &Simulation<'_>, k: usize, last: usize) -> Result<(), Error>;
     /// Whether [`Observer::observe`] after step `k` reads the displacements of the condensed
     /// foundation's nodes (frames, monitors there). With the Schur-complement condensation they
     /// are reconstructed only then (one solve) and are 0 in the state otherwise
     /// (`foundation`). Default true (always right; an observer that knows its schedule says
     /// when).
-    fn full_state_due(&self, _sim: &Simulation<'_>, _k: usize, _n_steps: usize) -> bool {
+    fn full_state_due(&self, _sim: &Simulation<'_>, _k: usize, _last: usize) -> bool {
         true
+    }
+    /// The last output index the observer wants (an interrupted run), if earlier than the
+    /// scene's; asked after every `observe`.
+    fn stop_after(&self) -> Option<usize> {
+        None
     }
     /// After the last step.
     fn finish(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
@@ -220,22 +229,31 @@ impl<'p> Simulation<'p> {
         Kinematics { t: self.state.t, dt: self.time.dt, u_prev: &self.state.u, u: &self.state.u, u_next: &self.state.u }
     }
 
-    /// `n` dynamic steps with `observer` watching.
+    /// Outputs at t[0] … t[n] with `observer` watching: n + 1 dynamic steps (the last only
+    /// computes u[n+1] for the velocity and acceleration at t[n]); none when n = 0 (the observer's
+    /// `start` sees the state at rest). Fewer when the observer asks to stop.
     pub fn run_steps(&mut self, n: usize, observer: &mut dyn Observer) -> Result<(), Error> {
         observer.start(self)?;
-        for k in 0..n {
+        let mut last = n;
+        let mut k = 0;
+        while n > 0 && k <= last {
             self.step()?;
-            if observer.full_state_due(self, k, n) {
+            if observer.full_state_due(self, k, last) {
                 self.complete_state()?;
             } else {
                 self.clear_condensed_state();
             }
-            observer.observe(self, k, n)?;
+            observer.observe(self, k, last)?;
+            if let Some(s) = observer.stop_after() {
+                last = last.min(s.max(k));
+            }
+            k += 1;
         }
         observer.finish(self)
     }
 
-    /// The scene's duration ([`Self::n_steps`] dynamic steps) with `observer` watching.
+    /// The scene's duration ([`Self::n_steps`] dynamic steps, outputs up to t = duration) with
+    /// `observer` watching.
     pub fn run(&mut self, observer: &mut dyn Observer) -> Result<(), Error> {
         self.run_steps(self.n_steps(), observer)
     }

@@ -892,6 +892,7 @@ impl ContactSolver<'_> {
             rec.max_sweeps = rec.max_sweeps.max(sweeps);
             if !converged {
                 rec.unconverged_steps += 1;
+                rec.max_gs_residual = rec.max_gs_residual.max(residual);
             }
         }
         for a in &self.active {

@@ -62,6 +62,8 @@ pub struct JointRecord {
     /// The last sweep's largest net node change of the last step [m] (its residual: below
     /// `gs_tolerance` when converged; the amount left when the sweep budget ran out).
     pub gs_residual: f64,
+    /// The largest `gs_residual` of the steps that stopped at the sweep budget [m] (0 if none).
+    pub max_gs_residual: f64,
 }
 
 /// Contact history of all joints (part of the run's `State`).

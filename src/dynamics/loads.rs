@@ -55,6 +55,14 @@ fn base_motion(scene: &Scene, k: usize, b: &BaseRecord) -> Result<(BaseMotion, S
         (None, Some(s)) => synth_record(scene, b, s, &format!("loads.base[{k}].synth")).map_err(|e| invalid(e.to_string()))?,
         _ => return Err(invalid("give `record` or `synth`, exactly one".into())),
     };
+    let duration = scene.time.duration;
+    if duration > 0.0 && (record.t0 >= duration || record.t_end() < 0.0) {
+        return Err(invalid(format!(
+            "the {source} spans t = {} … {} s, entirely outside the run (0 … {duration} s): the base would not move. The file's times are used as they are: shift them to start near 0, or lengthen time.duration",
+            record.t0,
+            record.t_end()
+        )));
+    }
     let baseline = b.baseline.resolve().map_err(invalid)?;
     let before = drift(&record.accel, record.dt);
     if let Some(m) = &baseline {

@@ -1,10 +1,20 @@
-//! CSV histories of monitored points: one file per point, one row per history step:
-//! `t, ux, uy, uz, vx, vy, vz, ax, ay, az` (SI, relative to the base). Rows are flushed at
-//! every frame, so a crash leaves the rows written up to the last frame.
+//! CSV histories of monitored points: one file per point, `histories/<monitor>.csv`, one row
+//! per history row: [`MONITOR_HEADER`] (SI, relative to the base). Units are part of the column
+//! names (`ux [m]`); the readers find a column by its name with or without the unit.
+//! The first line is the header (ParaView's CSV reader and spreadsheets take it as such); where
+//! each monitor snapped (node, requested point, distance) is in `histories/monitors.json`
+//! (written when the run starts) and in `summary.json`.
+//!
+//! Crash safety: rows are kept in memory and written as whole lines at frame boundaries
+//! ([`CsvLines`]), so a killed run or a full disk leaves at most one incomplete last line, which
+//! [`HistoryTable::read`] ignores.
 
 use crate::error::OutputError;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
+
+/// Header of a monitor history.
+pub const MONITOR_HEADER: &str = "t [s],ux [m],uy [m],uz [m],vx [m/s],vy [m/s],vz [m/s],ax [m/s^2],ay [m/s^2],az [m/s^2]";
 
 /// A monitored point snapped to a node.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -18,54 +28,105 @@ pub struct Monitor {
     pub snap_distance: f64,
 }
 
+/// A CSV file written in whole lines: the header at once, then rows gathered in memory
+/// ([`Self::buf`], each ending in `\n`) and written by [`Self::flush`] (and when dropped, so a
+/// run stopped by an error keeps its rows).
+pub struct CsvLines {
+    path: PathBuf,
+    file: std::fs::File,
+    buf: String,
+}
+
+impl CsvLines {
+    /// Create `path` with its header line.
+    pub fn create(path: PathBuf, header: &str) -> Result<CsvLines, OutputError> {
+        let mut file = std::fs::File::create(&path).map_err(|e| OutputError::write(&path, e))?;
+        writeln!(file, "{header}").map_err(|e| OutputError::write(&path, e))?;
+        Ok(CsvLines { path, file, buf: String::new() })
+    }
+
+    /// The pending rows; append whole lines ending in `\n`.
+    pub fn buf(&mut self) -> &mut String {
+        &mut self.buf
+    }
+
+    /// Write the pending rows.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        if !self.buf.is_empty() {
+            self.file.write_all(self.buf.as_bytes()).map_err(|e| OutputError::write(&self.path, e))?;
+            self.buf.clear();
+        }
+        Ok(())
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+impl Drop for CsvLines {
+    fn drop(&mut self) {
+        let _ = self.flush();
+    }
+}
+
 pub struct HistoryWriter {
-    files: Vec<(PathBuf, BufWriter<std::fs::File>)>,
+    files: Vec<CsvLines>,
 }
 
 impl HistoryWriter {
+    /// One history per monitor in `dir`, and `dir/monitors.json` (the monitors as snapped).
     pub fn create(dir: &Path, monitors: &[Monitor]) -> Result<HistoryWriter, OutputError> {
         std::fs::create_dir_all(dir).map_err(|e| OutputError::write(dir, e))?;
         let mut files = Vec::new();
         for m in monitors {
-            let p = dir.join(format!("{}.csv", m.name));
-            let f = std::fs::File::create(&p).map_err(|e| OutputError::write(&p, e))?;
-            let mut w = BufWriter::new(f);
-            writeln!(w, "# monitor {} at node {} ({:.6}, {:.6}, {:.6}), snapped {:.3e} m from ({}, {}, {})",
-                m.name, m.node_tag, m.position[0], m.position[1], m.position[2], m.snap_distance,
-                m.requested[0], m.requested[1], m.requested[2]).map_err(|e| OutputError::write(&p, e))?;
-            writeln!(w, "t,ux,uy,uz,vx,vy,vz,ax,ay,az").map_err(|e| OutputError::write(&p, e))?;
-            files.push((p, w));
+            files.push(CsvLines::create(dir.join(format!("{}.csv", m.name)), MONITOR_HEADER)?);
+        }
+        if !monitors.is_empty() {
+            let p = dir.join("monitors.json");
+            std::fs::write(&p, serde_json::to_string_pretty(monitors).expect("monitors serialise")).map_err(|e| OutputError::write(&p, e))?;
         }
         Ok(HistoryWriter { files })
     }
 
     /// Append one row per monitor: values are [u; v; a] (9) per monitor.
-    pub fn row(&mut self, t: f64, values: &[[f64; 9]]) -> Result<(), OutputError> {
-        for ((p, w), v) in self.files.iter_mut().zip(values) {
-            write!(w, "{t:.9e}").map_err(|e| OutputError::write(p.as_path(), e))?;
+    pub fn row(&mut self, t: f64, values: &[[f64; 9]]) {
+        use std::fmt::Write as _;
+        for (f, v) in self.files.iter_mut().zip(values) {
+            let b = f.buf();
+            let _ = write!(b, "{t:.9e}");
             for x in v {
-                write!(w, ",{x:.9e}").map_err(|e| OutputError::write(p.as_path(), e))?;
+                let _ = write!(b, ",{x:.9e}");
             }
-            writeln!(w).map_err(|e| OutputError::write(p.as_path(), e))?;
+            b.push('\n');
         }
-        Ok(())
     }
 
+    /// Write the pending rows (whole lines).
     pub fn flush(&mut self) -> Result<(), OutputError> {
-        for (p, w) in &mut self.files {
-            w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
+        for f in &mut self.files {
+            f.flush()?;
         }
         Ok(())
     }
 
     pub fn paths(&self) -> Vec<PathBuf> {
-        self.files.iter().map(|(p, _)| p.clone()).collect()
+        self.files.iter().map(|f| f.path().to_path_buf()).collect()
     }
 }
 
+/// Read `histories/monitors.json` (the monitors as snapped, written by [`HistoryWriter::create`]).
+pub fn read_monitors(histories_dir: &Path) -> Result<Vec<Monitor>, OutputError> {
+    let p = histories_dir.join("monitors.json");
+    let text = std::fs::read_to_string(&p).map_err(|e| OutputError::read(&p, e))?;
+    serde_json::from_str(&text).map_err(|e| OutputError::read(&p, format!("not a monitor list: {e}")))
+}
+
 /// A CSV history read back by column name: the monitor histories of [`HistoryWriter`] and
-/// the joint histories of [`super::joints`] (`#` comment lines, one header line of column
-/// names, then rows of numbers; `NaN` is a number). Every row must have one value per
+/// the joint histories of [`super::joints`] (one header line of column names, then rows of
+/// numbers; `NaN` is a number; `#` lines, as older runs wrote, are skipped). A column is found
+/// by its full name (`ux [m]`) or by its name without the unit (`ux`). An incomplete last line
+/// (no line end: a run killed while writing) is ignored; any other row must have one value per
 /// column: a truncated or non-numeric cell is an error naming the file, line and column.
 #[derive(Clone, Debug)]
 pub struct HistoryTable {
@@ -82,7 +143,12 @@ impl HistoryTable {
         let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
         let mut columns: Option<Vec<String>> = None;
         let mut data: Vec<Vec<f64>> = Vec::new();
-        for (ln, line) in text.lines().enumerate() {
+        // a last line without its line end was cut by a kill or a full disk: not a row
+        let whole = match text.rfind('\n') {
+            Some(i) => &text[..=i],
+            None => "",
+        };
+        for (ln, line) in whole.lines().enumerate() {
             if line.starts_with('#') || line.trim().is_empty() {
                 continue;
             }
@@ -116,7 +182,8 @@ impl HistoryTable {
 
     /// The values of column `name`; an error naming the file and the columns it has if absent.
     pub fn column(&self, name: &str) -> Result<&[f64], OutputError> {
-        let i = self.columns.iter().position(|c| c == name).ok_or_else(|| {
+        let bare = |c: &str| c.split(" [").next().unwrap_or(c).to_string();
+        let i = self.columns.iter().position(|c| c == name || bare(c) == name).ok_or_else(|| {
             OutputError::read(&self.path, format!("no column `{name}` (columns: {})", self.columns.join(", ")))
         })?;
         Ok(&self.data[i])

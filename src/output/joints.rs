@@ -5,16 +5,27 @@
 //! `normal` (3), `gap` (m, NaN when the node found no master face), `opening` = max(gap, 0) (m),
 //! `slip` (accumulated slip path, m), `tangential_displacement` |d_t| (m), `normal_traction`
 //! (Pa, compression positive), `shear_traction` (Pa), `state` (0 open, 1 stick, 2 slip,
-//! 3 bonded), `tributary_area` (m²).
+//! 3 bonded; the labels are in the file's FieldData as `state_label_<name>`), `lost` (1 where the
+//! node found no master face, else 0), `lost_travel` (m), `tributary_area` (m²).
+//!
+//! Lost nodes (no master face: slid off the master's edge): the contact's own slip and |d_t|
+//! stop there, so on a lost node `slip` and `tangential_displacement` go on with `lost_travel`,
+//! the distance the node moved relative to the master node it was last near (its candidate
+//! set's centre) since the last output where it was in contact. `gap` is NaN there, which
+//! ParaView spreads over the node's triangles: colour by `lost` or threshold it away.
+//!
+//! Time: the contact state after step k is the state at t[k + 1]; the recorder writes it with
+//! that time, the same as the volume frame and the monitors' row of t[k + 1].
 
 use crate::vtk::pvd::PvdSeries;
-use crate::vtk::vtu::{write_vtu, Field, Grid};
+use crate::vtk::vtu::{write_vtu_labelled, Field, Grid};
 use crate::contact::state::{ContactState, JointRecord};
 use crate::contact::joint::ContactJoint;
 use crate::contact::law::PairState;
 use crate::error::OutputError;
 use crate::mesh::CellKind;
-use std::io::{BufWriter, Write};
+use super::history::CsvLines;
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Running maxima of one joint (for the summary).
@@ -42,17 +53,68 @@ pub struct JointPeaks {
     pub events: crate::contact::state::SearchEvents,
     /// Largest slave-to-O distance (the NTN geometric error) [m].
     pub ntn_max_distance: f64,
+    /// Largest `lost_travel` of a lost node [m] (see the module doc).
+    #[serde(default)]
+    pub max_lost_travel: f64,
+    /// The last sweep's residual of the worst step [m] (largest node change left when a step
+    /// stopped at the sweep budget; 0 when every step converged).
+    #[serde(default)]
+    pub max_gs_residual: f64,
+    /// Typical slave face size √(slave area / faces) [m] (the scale of the NTN warning).
+    #[serde(default)]
+    pub face_size: f64,
 }
+
+/// Header of `histories/joint_<joint>.csv`: maxima over the slave nodes [m], the pairs per
+/// state (`open` counts the lost ones too), the step's Gauss–Seidel sweeps, the summed normal
+/// (compressive) and |tangential| force [N], the lost pairs and their largest `lost_travel` [m].
+pub const JOINT_HEADER: &str = "t [s],max_opening [m],max_slip [m],max_tangential_displacement [m],max_penetration [m],open,stick,slip,bonded,sweeps,normal_force [N],shear_force [N],lost,max_lost_travel [m]";
+
+/// The codes of the joint series' `state` array and their names (its FieldData labels).
+pub const STATE_LABELS: [(&str, i32); 4] = [("state_label_open", 0), ("state_label_stick", 1), ("state_label_slip", 2), ("state_label_bonded", 3)];
 
 pub struct JointWriter {
     dir: PathBuf,
     series: Vec<PvdSeries>,
-    csv: Vec<(PathBuf, BufWriter<std::fs::File>)>,
+    csv: Vec<CsvLines>,
     pub peaks: Vec<JointPeaks>,
     frames: bool,
     /// The opt-in force diagnostic (`output.joint_forces`): per joint its CSV and, per pair,
     /// whether it was closed at the last row (for the open/close transitions).
-    forces: Vec<(PathBuf, BufWriter<std::fs::File>, Vec<bool>)>,
+    forces: Vec<(CsvLines, Vec<bool>)>,
+    /// Per joint and slave node: the node's displacement relative to its candidate centre at
+    /// the last output where it was in contact (the origin of `lost_travel`).
+    anchor: Vec<Vec<[f64; 3]>>,
+    /// Set while the contact has not been searched yet (t = 0 of a run without gravity
+    /// equilibrium): a pair's gap is then the tagger's distance to the master surface at rest,
+    /// and no node counts as lost.
+    pub unsearched: bool,
+}
+
+/// `r` as the outputs show it: before the first search, the gaps at rest from the tagger.
+fn searched_view<'a>(unsearched: bool, j: &ContactJoint, r: &'a JointRecord) -> std::borrow::Cow<'a, JointRecord> {
+    if !unsearched {
+        return std::borrow::Cow::Borrowed(r);
+    }
+    let mut r = r.clone();
+    for (p, d) in r.pairs.iter_mut().zip(&j.tag.surface_distance) {
+        if !p.gap.is_finite() {
+            p.gap = *d;
+        }
+    }
+    std::borrow::Cow::Owned(r)
+}
+
+/// Slave node `i`'s displacement relative to its candidate centre on the master.
+fn relative_to_centre(j: &ContactJoint, r: &JointRecord, i: usize, u: &[f64]) -> [f64; 3] {
+    let s = j.tag.slave.nodes[i];
+    let m = j.tag.master.nodes.get(r.pairs[i].center as usize).copied().unwrap_or(s);
+    [u[3 * s] - u[3 * m], u[3 * s + 1] - u[3 * m + 1], u[3 * s + 2] - u[3 * m + 2]]
+}
+
+/// Whether pair `p` is lost (found no master face).
+fn is_lost(p: &crate::contact::state::PairRecord) -> bool {
+    !p.gap.is_finite()
 }
 
 /// Header of `histories/joint_<joint>_forces.csv` (the opt-in force diagnostic, see
@@ -90,12 +152,7 @@ impl JointWriter {
         let mut peaks = Vec::new();
         for j in joints {
             series.push(PvdSeries::new(dir.join(format!("{}.pvd", j.tag.name))));
-            let p = hdir.join(format!("joint_{}.csv", j.tag.name));
-            let f = std::fs::File::create(&p).map_err(|e| OutputError::write(&p, e))?;
-            let mut w = BufWriter::new(f);
-            writeln!(w, "t,max_opening,max_slip,max_tangential_displacement,max_penetration,open,stick,slip,bonded,sweeps,normal_force,shear_force")
-                .map_err(|e| OutputError::write(&p, e))?;
-            csv.push((p, w));
+            csv.push(CsvLines::create(hdir.join(format!("joint_{}.csv", j.tag.name)), JOINT_HEADER)?);
             peaks.push(JointPeaks {
                 name: j.tag.name.clone(),
                 method: format!("{:?}", j.method),
@@ -103,25 +160,49 @@ impl JointWriter {
                 master_group: j.tag.master.group.clone(),
                 slave_nodes: j.tag.n_slave(),
                 ntn_max_distance: j.tag.ntn_max_distance,
+                face_size: (j.tag.slave.area / j.tag.slave.faces.len().max(1) as f64).sqrt(),
                 ..Default::default()
             });
         }
         let mut fcsv = Vec::new();
         if forces {
             for j in joints {
-                let p = hdir.join(format!("joint_{}_forces.csv", j.tag.name));
-                let f = std::fs::File::create(&p).map_err(|e| OutputError::write(&p, e))?;
-                let mut w = BufWriter::new(f);
-                writeln!(w, "{JOINT_FORCES_HEADER}").map_err(|e| OutputError::write(&p, e))?;
-                fcsv.push((p, w, vec![false; j.tag.n_slave()]));
+                fcsv.push((CsvLines::create(hdir.join(format!("joint_{}_forces.csv", j.tag.name)), JOINT_FORCES_HEADER)?, vec![false; j.tag.n_slave()]));
             }
         }
-        Ok(JointWriter { dir, series, csv, peaks, frames, forces: fcsv })
+        let anchor = joints.iter().map(|j| vec![[f64::NAN; 3]; j.tag.n_slave()]).collect();
+        Ok(JointWriter { dir, series, csv, peaks, frames, forces: fcsv, anchor, unsearched: false })
     }
 
-    /// Update maxima and append a history row per joint at time `t`.
-    pub fn record(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState) -> Result<(), OutputError> {
+    /// Per slave node of joint `k`: its `lost_travel` [m] (0 when in contact) at displacement
+    /// `u`, moving the anchors of the nodes in contact.
+    fn lost_travel(&mut self, k: usize, j: &ContactJoint, r: &JointRecord, u: &[f64]) -> Vec<f64> {
+        let anchor = &mut self.anchor[k];
+        (0..r.pairs.len())
+            .map(|i| {
+                let rel = relative_to_centre(j, r, i, u);
+                if !is_lost(&r.pairs[i]) || anchor[i][0].is_nan() {
+                    // in contact, or lost since before the first output: travel counts from here
+                    anchor[i] = rel;
+                }
+                if is_lost(&r.pairs[i]) {
+                    let a = anchor[i];
+                    ((rel[0] - a[0]).powi(2) + (rel[1] - a[1]).powi(2) + (rel[2] - a[2]).powi(2)).sqrt()
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+
+    /// Update maxima and append a history row per joint at time `t` (the contact `state` and
+    /// the displacement `u` of that time).
+    pub fn record(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState, u: &[f64]) -> Result<(), OutputError> {
         for (k, (j, r)) in joints.iter().zip(&state.joints).enumerate() {
+            let r = &*searched_view(self.unsearched, j, r);
+            let travel = self.lost_travel(k, j, r, u);
+            let lost = r.pairs.iter().filter(|p| is_lost(p)).count();
+            let ml = travel.iter().copied().fold(0.0f64, f64::max);
             let mut mo = 0.0f64;
             let mut ms = 0.0f64;
             let mut md = 0.0f64;
@@ -148,26 +229,26 @@ impl JointWriter {
             pk.max_penetration = pk.max_penetration.max(mp);
             pk.max_sweeps = r.max_sweeps;
             pk.unconverged_steps = r.unconverged_steps;
+            pk.max_gs_residual = pk.max_gs_residual.max(r.max_gs_residual);
             pk.events = r.events.clone();
+            pk.max_lost_travel = pk.max_lost_travel.max(ml);
             let c = state_counts(r);
-            let (p, w) = &mut self.csv[k];
-            writeln!(w, "{t:.9e},{mo:.9e},{ms:.9e},{md:.9e},{mp:.9e},{},{},{},{},{},{fn_:.9e},{ft:.9e}", c[0], c[1], c[2], c[3], r.sweeps)
-                .map_err(|e| OutputError::write(p.as_path(), e))?;
-            if let Some((p, w, was_closed)) = self.forces.get_mut(k) {
+            let _ = writeln!(self.csv[k].buf(), "{t:.9e},{mo:.9e},{ms:.9e},{md:.9e},{mp:.9e},{},{},{},{},{},{fn_:.9e},{ft:.9e},{lost},{ml:.9e}", c[0], c[1], c[2], c[3], r.sweeps);
+            if let Some((w, was_closed)) = self.forces.get_mut(k) {
                 let row = force_row(j, r, was_closed);
-                writeln!(w, "{t:.9e},{row}").map_err(|e| OutputError::write(p.as_path(), e))?;
+                let _ = writeln!(w.buf(), "{t:.9e},{row}");
             }
         }
         Ok(())
     }
 
-    /// Flush the CSV histories (rows written so far reach the disk).
+    /// Write the pending history rows (whole lines).
     pub fn flush(&mut self) -> Result<(), OutputError> {
-        for (p, w) in &mut self.csv {
-            w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
+        for w in &mut self.csv {
+            w.flush()?;
         }
-        for (p, w, _) in &mut self.forces {
-            w.flush().map_err(|e| OutputError::write(p.as_path(), e))?;
+        for (w, _) in &mut self.forces {
+            w.flush()?;
         }
         Ok(())
     }
@@ -179,6 +260,8 @@ impl JointWriter {
             return Ok(());
         }
         for (k, (j, r)) in joints.iter().zip(&state.joints).enumerate() {
+            let r = &*searched_view(self.unsearched, j, r);
+            let travel = self.lost_travel(k, j, r, u);
             let surf = &j.tag.slave;
             let np = surf.nodes.len();
             let mut disp = Vec::with_capacity(3 * np);
@@ -186,6 +269,7 @@ impl JointWriter {
             let (mut gap, mut opening, mut slip, mut dtan, mut sn, mut st, mut area) =
                 (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
             let mut code = Vec::with_capacity(np);
+            let mut lost = Vec::with_capacity(np);
             for (i, &n) in surf.nodes.iter().enumerate() {
                 disp.extend_from_slice(&u[3 * n..3 * n + 3]);
                 normal.extend_from_slice(&j.tag.normals[i]);
@@ -193,8 +277,9 @@ impl JointWriter {
                 let a = j.tag.areas[i];
                 gap.push(p.gap);
                 opening.push(if p.gap.is_finite() { p.gap.max(0.0) } else { 0.0 });
-                slip.push(p.slip);
-                dtan.push((p.d_t[0] * p.d_t[0] + p.d_t[1] * p.d_t[1]).sqrt());
+                slip.push(p.slip + travel[i]);
+                dtan.push((p.d_t[0] * p.d_t[0] + p.d_t[1] * p.d_t[1]).sqrt() + travel[i]);
+                lost.push(is_lost(p) as i32);
                 sn.push(p.r_n / a);
                 st.push((p.r_t[0] * p.r_t[0] + p.r_t[1] * p.r_t[1]).sqrt() / a);
                 area.push(a);
@@ -204,7 +289,7 @@ impl JointWriter {
             let grid = Grid { points: &surf.points, cells };
             let idx = self.series[k].len();
             let path = self.dir.join(format!("{}_{idx:05}.vtu", j.tag.name));
-            write_vtu(
+            write_vtu_labelled(
                 &path,
                 &grid,
                 &[
@@ -217,9 +302,12 @@ impl JointWriter {
                     Field::f64("normal_traction", 1, &sn),
                     Field::f64("shear_traction", 1, &st),
                     Field::i32("state", 1, &code),
+                    Field::i32("lost", 1, &lost),
+                    Field::f64("lost_travel", 1, &travel),
                     Field::f64("tributary_area", 1, &area),
                 ],
                 &[],
+                &STATE_LABELS,
             )?;
             self.series[k].push(t, &path)?;
         }
@@ -231,7 +319,7 @@ impl JointWriter {
     }
 
     pub fn csv_paths(&self) -> Vec<PathBuf> {
-        self.csv.iter().map(|(p, _)| p.clone()).chain(self.forces.iter().map(|(p, _, _)| p.clone())).collect()
+        self.csv.iter().map(|w| w.path().to_path_buf()).chain(self.forces.iter().map(|(w, _)| w.path().to_path_buf())).collect()
     }
 }
 
@@ -313,7 +401,9 @@ pub struct JointForcesRow {
 /// file and the line.
 pub fn read_joint_forces(path: &Path) -> Result<Vec<JointForcesRow>, OutputError> {
     let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
-    let mut lines = text.lines();
+    // a last line without its line end was cut by a kill or a full disk: not a row
+    let whole = text.rfind('\n').map_or("", |i| &text[..=i]);
+    let mut lines = whole.lines();
     if lines.next() != Some(JOINT_FORCES_HEADER) {
         return Err(OutputError::read(path, format!("the first line is not the force diagnostic's header `{JOINT_FORCES_HEADER}`")));
     }

@@ -1,10 +1,19 @@
 //! The run's recorder: what a run writes and watches while it steps (an observer of a
 //! [`Simulation`]).
 //!
-//! - **Schedule**: a history row every `output.history_stride` steps (monitors and joints), a
-//!   frame every `output.frame_stride` steps, or every `frame_interval` seconds, or about 100
-//!   frames over the run; the last step always writes a frame. A run of no steps writes the
+//! - **Clock**: every output (history row, volume frame, joint frame) carries the state at the
+//!   time it is stamped with, t[m] = m dt for output index m = 0 … N (N = duration / dt): the
+//!   monitors and volume frames from the kinematics after step m (u[m−1], u[m], u[m+1]), the
+//!   joints from the contact state after step m − 1 (the state at t[m]; at m = 0 the
+//!   equilibrium). The last row and frame are at t[N] = duration.
+//! - **Schedule**: a history row every `output.history_stride` steps or `history_interval`
+//!   seconds (default [`DEFAULT_HISTORY_INTERVAL`], at least [`MIN_HISTORY_ROWS`] rows over the
+//!   run), a frame every `output.frame_stride` steps, or every `frame_interval` seconds, or
+//!   about 100 frames over the run; t[0] and t[N] always get both. A run of no steps writes the
 //!   equilibrium state as its one frame.
+//! - **Interruption**: Ctrl-C or SIGTERM ([`install_interrupt_handler`]) ends the run at the
+//!   next output index: its row and frames are written whole and the summary says
+//!   `interrupted`.
 //! - **Monitors**: the scene's points snapped to nodes ([`snap_monitors`]).
 //! - **Peaks**: |u|, |v|, |a| of any node, sampled every [`PEAK_STRIDE`] steps and at the last.
 //! - **Progress**: a bar on stderr when asked for and stderr is a terminal; nothing otherwise.
@@ -31,6 +40,64 @@ use std::path::{Path, PathBuf};
 /// about a step's nodal update; one in ten keeps it under 10 % and still samples a 10 Hz
 /// response 40 times a period at the wedge's dt (2.6e-4 s).
 pub const PEAK_STRIDE: usize = 10;
+
+/// Default time between two history rows [s] when the scene gives neither `history_stride` nor
+/// `history_interval`: 1 ms, 1000 rows a second, 10 samples a period at 100 Hz (beyond the
+/// content of any earthquake record) at about 200 B a row for a monitor (250 B for a joint):
+/// 2 MB per monitor for a 10 s run, whatever its step (every step wrote 1.37 GB for a 5 M-step
+/// run).
+pub const DEFAULT_HISTORY_INTERVAL: f64 = 1e-3;
+
+/// With the default interval, a run gets at least this many rows (short runs: impacts, waves):
+/// the interval is min(1 ms, duration / 1000), never below one step.
+pub const MIN_HISTORY_ROWS: f64 = 1000.0;
+
+/// A joint whose lost node-steps (no master face: no contact force) exceed this fraction of its
+/// slave node-steps gets a warning: 1 %. A lost node is force-free, so a block whose contact is
+/// lost sinks into or falls through its base with the run still "passing" (`on_exit: "report"`
+/// let a block sink 3.7 m); 1 % is far above the few edge nodes of a sliding wedge that daylight
+/// near the end of a run, and far below a face that lost its contact.
+pub const LOST_WARN_FRACTION: f64 = 0.01;
+
+/// A joint whose Gauss–Seidel stopped at `gs_max_sweeps` with a residual (largest node change
+/// of the last sweep) above this factor times its tolerance gets a warning: 10. Below it the
+/// fixed point is within one decade of the requested accuracy, which the runs at the cap (wedge,
+/// 1.5 g) reach; above it the contact forces of those steps are not converged.
+pub const GS_WARN_FACTOR: f64 = 10.0;
+
+/// An NTN joint whose largest slave-to-O distance exceeds this fraction of the slave face size
+/// gets a warning: 0.1. NTN pairs each slave node with one master point O fixed at tagging; on a
+/// non-conforming mesh the offset is a lever arm of the contact force (39–135 % stress error on a
+/// patch test): use NTS there.
+pub const NTN_WARN_FRACTION: f64 = 0.1;
+
+/// Set by Ctrl-C / SIGTERM / SIGHUP once [`install_interrupt_handler`] ran.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Make Ctrl-C, SIGTERM and SIGHUP end a run cleanly: the first prints one line and the run
+/// stops at its next output (row and frames written, `summary.json` marked `interrupted`); a
+/// second quits at once (exit status 130). For the CLI; call once.
+pub fn install_interrupt_handler() -> Result<(), String> {
+    ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("interrupted: finishing the current output and writing summary.json (press Ctrl-C again to quit at once)");
+    })
+    .map_err(|e| format!("cannot install the Ctrl-C handler: {e}"))
+}
+
+/// The steps between two history rows for `spec` at step `dt` over `duration` [s].
+pub fn history_stride(spec: &crate::scene::OutputSpec, dt: f64, duration: f64) -> usize {
+    match (spec.history_stride, spec.history_interval) {
+        (Some(k), _) => k.max(1),
+        (None, Some(hi)) => ((hi / dt).round() as usize).max(1),
+        (None, None) => {
+            let hi = DEFAULT_HISTORY_INTERVAL.min(duration / MIN_HISTORY_ROWS);
+            ((hi / dt).floor() as usize).max(1)
+        }
+    }
+}
 
 /// Snap monitored points to nodes (optionally of a group; else the nearest node with inertia).
 pub fn snap_monitors(model: &Model, scene: &Scene) -> Result<Vec<Monitor>, Error> {
@@ -104,6 +171,8 @@ pub struct Recorder {
     hist_stride: usize,
     rows: Vec<[f64; 9]>,
     bar: indicatif::ProgressBar,
+    /// The last output index after an interruption.
+    stop: Option<usize>,
 }
 
 impl Recorder {
@@ -150,9 +219,10 @@ impl Recorder {
             joints,
             peaks: Peaks::default(),
             frame_stride,
-            hist_stride: scene.output.history_stride.max(1),
+            hist_stride: history_stride(&scene.output, dt, scene.time.duration),
             rows,
             bar,
+            stop: None,
         })
     }
 
@@ -203,64 +273,133 @@ impl Recorder {
             timings,
             wall_time,
             provenance: Some(crate::output::summary::Provenance::of_this_process()),
+            interrupted: self.stop.map(|m| m as f64 * sim.dt()),
+            history_rows_every: self.hist_stride as f64 * sim.dt(),
+            warnings: self.warnings(sim),
         }
+    }
+
+    /// What the run got through but should not be trusted without a look: lost contact
+    /// ([`LOST_WARN_FRACTION`]), an unconverged Gauss–Seidel ([`GS_WARN_FACTOR`]), NTN on a
+    /// non-conforming joint ([`NTN_WARN_FRACTION`]).
+    fn warnings(&self, sim: &Simulation<'_>) -> Vec<String> {
+        let mut w = Vec::new();
+        let Some(jw) = self.joints.as_ref() else { return w };
+        let steps = self.stop.unwrap_or(sim.n_steps()).max(1) as f64;
+        for (pk, j) in jw.peaks.iter().zip(&sim.problem.joints) {
+            let node_steps = pk.slave_nodes.max(1) as f64 * steps;
+            let lost = pk.events.lost as f64 / node_steps;
+            if lost > LOST_WARN_FRACTION {
+                let hint = if matches!(j.on_exit, crate::contact::joint::OnExit::Widen) { "" } else { " (on_exit \"report\": the candidate set never follows the node; use \"widen\")" };
+                w.push(format!(
+                    "joint {}: {} node-steps lost ({:.1} % of its slave node-steps, above {:.0} %): lost nodes carry no contact force, so a block can sink into or fall through its base; the largest lost travel was {:.3e} m{hint}",
+                    pk.name, pk.events.lost, 100.0 * lost, 100.0 * LOST_WARN_FRACTION, pk.max_lost_travel
+                ));
+            }
+            if pk.unconverged_steps > 0 && pk.gs_tolerance > 0.0 && pk.max_gs_residual > GS_WARN_FACTOR * pk.gs_tolerance {
+                w.push(format!(
+                    "joint {}: Gauss–Seidel stopped at gs_max_sweeps in {} steps with a residual up to {:.2e} m, {:.0} × its tolerance {:.1e} m (above {GS_WARN_FACTOR}×): the contact forces of those steps are not converged (cap: ContactSolver::gs_max_sweeps, 200 sweeps)",
+                    pk.name, pk.unconverged_steps, pk.max_gs_residual, pk.max_gs_residual / pk.gs_tolerance, pk.gs_tolerance
+                ));
+            }
+            if matches!(j.method, Method::Ntn) && pk.ntn_max_distance > NTN_WARN_FRACTION * pk.face_size {
+                w.push(format!(
+                    "joint {}: NTN on a non-conforming joint: a slave node is {:.3e} m from its master point O, {:.0} % of the face size {:.3e} m (above {:.0} %): the offset acts as a lever arm (stress errors of tens of %); use method \"nts\"",
+                    pk.name, pk.ntn_max_distance, 100.0 * pk.ntn_max_distance / pk.face_size, pk.face_size, 100.0 * NTN_WARN_FRACTION
+                ));
+            }
+        }
+        w
+    }
+
+    /// Whether output index `m` gets a history row (`last`: the run's last index).
+    fn history_due(&self, m: usize, last: usize) -> bool {
+        m % self.hist_stride == 0 || m == last
+    }
+
+    /// Whether output index `m` gets a frame.
+    fn frame_due(&self, m: usize, last: usize) -> bool {
+        m % self.frame_stride == 0 || m == last
     }
 }
 
 impl Observer for Recorder {
     fn start(&mut self, sim: &Simulation<'_>) -> Result<(), Error> {
+        let p = sim.problem;
         if sim.n_steps() > 0 {
+            // the joints at t[0]: the equilibrium's contact state (the volume's t[0] comes with
+            // the first step, which gives its velocity)
+            if let Some(jw) = self.joints.as_mut() {
+                jw.unsearched = sim.equilibrium.is_none();
+                jw.record(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
+                jw.write_frame(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
+                jw.unsearched = false;
+            }
             return Ok(());
         }
         // `duration: 0` runs only the equilibrium: write that state (at rest) as the one frame
-        let p = sim.problem;
         let kin = sim.kinematics_at_rest();
         let kin = Kinematics { t: 0.0, ..kin };
         for (r, m) in self.rows.iter_mut().zip(&self.monitors) {
             r[..3].copy_from_slice(&kin.u[3 * m.node..3 * m.node + 3]);
         }
-        self.history.row(0.0, &self.rows)?;
+        self.history.row(0.0, &self.rows);
+        self.history.flush()?;
         if let Some(f) = self.frames.as_mut() {
             f.write(&p.model, &kin)?;
         }
         if let Some(jw) = self.joints.as_mut() {
-            jw.record(0.0, &p.joints, &sim.state.contact)?;
+            jw.unsearched = sim.equilibrium.is_none();
+            jw.record(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
             jw.write_frame(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
+            jw.unsearched = false;
         }
         Ok(())
     }
 
     /// The foundation's displacements (Schur-complement condensation, docs/dam_physics.md) are
-    /// read by frames, the last step and monitors on condensed nodes; the peaks in between see
+    /// read by frames, the last output and monitors on condensed nodes; the peaks in between see
     /// them as 0 (the interface nodes, which bound them in practice, are always sampled).
-    fn full_state_due(&self, sim: &Simulation<'_>, k: usize, n_steps: usize) -> bool {
+    fn full_state_due(&self, sim: &Simulation<'_>, k: usize, last: usize) -> bool {
         let condensed = &sim.problem.model.condensed;
-        k + 1 == n_steps || (self.frames.is_some() && k % self.frame_stride == 0) || (k % self.hist_stride == 0 && self.monitors.iter().any(|m| condensed[m.node] != 0))
+        k == last || (self.frames.is_some() && self.frame_due(k, last)) || (self.history_due(k, last) && self.monitors.iter().any(|m| condensed[m.node] != 0))
     }
 
-    fn observe(&mut self, sim: &Simulation<'_>, k: usize, n_steps: usize) -> Result<(), Error> {
+    fn observe(&mut self, sim: &Simulation<'_>, k: usize, last: usize) -> Result<(), Error> {
         let p = sim.problem;
         let state = &sim.state;
-        // the step just taken gives u[n−1], u[n], u[n+1]: outputs are at t[n] = t − dt
-        let kin = sim.kinematics();
-        if k % self.hist_stride == 0 {
-            self.monitor_rows(&kin);
-            self.history.row(kin.t, &self.rows)?;
-            if let Some(jw) = self.joints.as_mut() {
-                jw.record(state.t, &p.joints, &state.contact)?;
-            }
+        let dt = sim.dt();
+        if self.stop.is_none() && k < last && INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+            self.stop = Some(k + 1);
         }
-        if k % PEAK_STRIDE == 0 || k + 1 == n_steps {
+        let last = self.stop.map_or(last, |s| s.min(last));
+        // the step just taken gives u[k−1], u[k], u[k+1]: the volume and monitors at t[k]
+        let kin = Kinematics { t: k as f64 * dt, ..sim.kinematics() };
+        if self.history_due(k, last) {
+            self.monitor_rows(&kin);
+            self.history.row(kin.t, &self.rows);
+        }
+        if k % PEAK_STRIDE == 0 || k == last {
             self.peaks.update(&p.model, &kin);
         }
-        if k % self.frame_stride == 0 || k + 1 == n_steps {
+        if self.frame_due(k, last) {
             if let Some(f) = self.frames.as_mut() {
                 f.write(&p.model, &kin)?;
             }
-            if let Some(jw) = self.joints.as_mut() {
-                jw.write_frame(state.t, &p.joints, &state.contact, &state.u)?;
-            }
             self.history.flush()?;
+        }
+        // ... and the contact state at t[k + 1], with u[k+1]
+        if k < last {
+            let t1 = (k + 1) as f64 * dt;
+            let (row, frame) = (self.history_due(k + 1, last), self.frame_due(k + 1, last));
+            if let Some(jw) = self.joints.as_mut() {
+                if row {
+                    jw.record(t1, &p.joints, &state.contact, &state.u)?;
+                }
+                if frame {
+                    jw.write_frame(t1, &p.joints, &state.contact, &state.u)?;
+                }
+            }
         }
         if k % 64 == 0 {
             self.bar.set_position(k as u64);
@@ -269,11 +408,14 @@ impl Observer for Recorder {
         Ok(())
     }
 
+    fn stop_after(&self) -> Option<usize> {
+        self.stop
+    }
+
     fn finish(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
         self.bar.finish_and_clear();
         self.history.flush()?;
         if let Some(jw) = self.joints.as_mut() {
-            // the last step already wrote its frame (k + 1 == n_steps in `observe`)
             jw.flush()?;
         }
         Ok(())

@@ -53,6 +53,17 @@ pub struct RunSummary {
     /// Stage wall times [s].
     pub timings: Vec<(String, f64)>,
     pub wall_time: f64,
+    /// Set when Ctrl-C / SIGTERM ended the run early: the time of its last output [s] (the
+    /// outputs up to there are whole).
+    #[serde(default)]
+    pub interrupted: Option<f64>,
+    /// Time between two history rows [s] (`output.history_stride` / `history_interval`).
+    #[serde(default)]
+    pub history_rows_every: f64,
+    /// What the run got through but should not be trusted without a look (lost contact, an
+    /// unconverged Gauss–Seidel, NTN on a non-conforming joint): also printed on the terminal.
+    #[serde(default)]
+    pub warnings: Vec<String>,
     /// Where and how the run ran (host, jointquake version and commit, Slurm ids); with
     /// `threads` and `wall_time` above, what a study's cost is summed from. `None` in summaries
     /// written before jointquake recorded it.
@@ -151,8 +162,18 @@ impl RunSummary {
                 s,
                 "  joint {:8} {} slave {} ({} nodes): max opening {:.3e} m, max slip {:.3e} m, max |d_t| {:.3e} m, max penetration {:.1e} m, GS sweeps ≤ {} (tolerance {:.1e} m){}",
                 j.name, j.method, j.slave_group, j.slave_nodes, j.max_opening, j.max_slip, j.max_tangential_displacement, j.max_penetration, j.max_sweeps, j.gs_tolerance,
-                if j.unconverged_steps > 0 { format!(" ({} steps unconverged)", j.unconverged_steps) } else { String::new() }
+                if j.unconverged_steps > 0 { format!(" ({} steps unconverged, residual up to {:.1e} m)", j.unconverged_steps, j.max_gs_residual) } else { String::new() }
             );
+            if j.method == "Ntn" {
+                let _ = writeln!(
+                    s,
+                    "                 NTN: largest slave-to-O distance {:.3e} m ({:.1} % of the face size {:.3e} m); penetration is measured against O, not the master surface",
+                    j.ntn_max_distance, 100.0 * j.ntn_max_distance / j.face_size.max(f64::MIN_POSITIVE), j.face_size
+                );
+            }
+            if j.max_lost_travel > 0.0 {
+                let _ = writeln!(s, "                 lost nodes travelled up to {:.3e} m off their last master node", j.max_lost_travel);
+            }
             let e = &j.events;
             if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures + e.recentred + e.perimeter_kept > 0 {
                 let _ = writeln!(
@@ -164,6 +185,12 @@ impl RunSummary {
         }
         for n in &self.notes {
             let _ = writeln!(s, "  note            {n}");
+        }
+        for w in &self.warnings {
+            let _ = writeln!(s, "  WARNING         {w}");
+        }
+        if let Some(t) = self.interrupted {
+            let _ = writeln!(s, "  INTERRUPTED     at t = {t:.6} s of {} s (outputs whole up to there)", self.duration);
         }
         let t: Vec<String> = self.timings.iter().map(|(k, v)| format!("{k} {v:.2} s")).collect();
         let _ = writeln!(s, "  wall time       {:.2} s ({})", self.wall_time, t.join(", "));

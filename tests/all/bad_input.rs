@@ -558,3 +558,12 @@ fn a_run_of_more_steps_than_max_steps_is_refused_up_front() {
     s["time"]["max_steps"] = json!(1);
     assert_mentions(&run_error("max_steps_1", &s), &["above time.max_steps = 1 "]);
 }
+
+/// Issue 19 §2: a record entirely outside the run time (its first time after the run's end) was
+/// accepted with exit 0 and the base never moved; now an error naming loads.base[0], the record's
+/// span, the run's span and the fix.
+#[test]
+fn record_entirely_outside_the_run_time_is_refused() {
+    let (msg, rec) = record_error("record_outside_run", "10.0 0.0\n10.01 0.1\n10.02 0.0\n");
+    assert_mentions(&msg, &["loads.base[0]", rec.to_str().unwrap(), "10 … 10.02 s", "entirely outside the run (0 … 0.001 s)", "time.duration"]);
+}

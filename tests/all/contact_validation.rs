@@ -512,7 +512,7 @@ fn impact_scene_transmits_the_wave_through_the_joint() {
     let text = std::fs::read_to_string(out.join("histories/joint_J.csv")).unwrap();
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = head.iter().position(|&h| h == "normal_force").expect("normal_force column");
+    let col = head.iter().position(|&h| h == "normal_force [N]").expect("normal_force column");
     let (f0, lc) = (1e4, 1e-3);
     let (mut sum, mut n) = (0.0, 0);
     let mut worst_zero: f64 = 0.0;
