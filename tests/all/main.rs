@@ -9,6 +9,7 @@ mod common;
 mod contact;
 mod contact_validation;
 mod dam_physics;
+mod dam_study;
 mod dynamics;
 mod fuzz;
 mod mesh;
