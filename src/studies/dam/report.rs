@@ -397,7 +397,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
                 let peak =
                     |h: &Vec<(f64, f64)>| mm(h.iter().map(|x| x.1.abs()).fold(0.0, f64::max));
                 let _ = t.push_row([
-                    format!("`{}`", r.id),
+                    format!("`{}`{}", r.id, stopped(r)),
                     peak(&r.crest[0].1),
                     peak(&r.crest[1].1),
                     peak(&r.crest[2].1),
@@ -420,7 +420,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
             match c.agreed {
                 Some(true) => "agreed".into(),
                 Some(false) => "**not agreed**".into(),
-                None => "not checked (runs missing)".into(),
+                None => "not checked (a run is missing or stopped)".into(),
             },
         ]);
     }
@@ -576,7 +576,8 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     );
     for &l in &levels {
         if let (Some(a), Some(b)) = (find(l, Method::Nts, true), find(l, Method::Ntn, true)) {
-            if a.joints == b.joints {
+            // both over the whole record: a stopped run's maxima end earlier
+            if a.joints == b.joints && a.failed.is_none() && b.failed.is_none() {
                 c.series.push(Series::markers(
                     lvl(l),
                     (0..a.joints.len())
