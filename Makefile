@@ -19,7 +19,7 @@ JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests dam-static
+.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests dam-static dam
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -56,6 +56,7 @@ demo: venv build
 	@echo "ParaView: open out/demo/wedge.pvd (the blocks) and out/demo/joints/A.pvd, B.pvd (joint surfaces: gap, slip, state),"
 	@echo "          File > Open, then Apply. Histories: out/demo/histories/*.csv. Charts: out/demo/charts/*.png (.svg)."
 	@echo "The whole study (PGA sweep, NTS/NTN/rigid, speed against accuracy, report): make wedge"
+	@echo "The arch dam study (28 joints at 1x, 2x, 3x the design PGA, NTS against NTN; out/dam/report.md): make dam"
 
 test: venv
 	JQ_REQUIRE_VENV=1 cargo test --release
@@ -149,6 +150,12 @@ joint-tests:
 .PHONY: test-slurm
 test-slurm: build
 	scripts/slurm/test.sh
+
+# The arch dam study (docs/dam.md, "Seismic study"; out/dam/report.md): 28 contraction joints at
+# 1x, 2x, 3x the design PGA, NTS and NTN; the coarse mesh, the monolithic dam and NTS-Layer2 at
+# 3x. Each run prints its start and end; a failed run is named in the report.
+dam:
+	$(MAKE) --no-print-directory study STUDY=pipelines/dam_study.json
 
 bench: build
 	cargo bench --bench explicit

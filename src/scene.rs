@@ -498,6 +498,26 @@ pub struct OutputSpec {
     /// ordinary run needs.
     #[serde(default)]
     pub joint_forces: bool,
+    /// Stress envelopes over time on face groups (`envelope.vtu`, `envelope.json`;
+    /// `output::envelope`). Default none.
+    #[serde(default)]
+    pub envelope: Option<EnvelopeSpec>,
+}
+
+/// `output.envelope`: the largest and smallest principal stress over the run of the elements
+/// under face groups (e.g. a dam's upstream and downstream faces).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvelopeSpec {
+    /// Face groups (dimension 2) on the outer surface of volume groups.
+    pub faces: Vec<String>,
+    /// Steps between two samples (and the last step). Default 10.
+    #[serde(default = "ten")]
+    pub stride: usize,
+}
+
+fn ten() -> usize {
+    10
 }
 
 fn yes() -> bool {
@@ -506,7 +526,7 @@ fn yes() -> bool {
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: None, history_interval: None, monitor: vec![], frames: true, joint_forces: false }
+        OutputSpec { dir: None, frame_stride: None, frame_interval: None, history_stride: None, history_interval: None, monitor: vec![], frames: true, joint_forces: false, envelope: None }
     }
 }
 
@@ -890,6 +910,11 @@ impl Scene {
         }
         if !matches!(self.equilibrium.method.as_str(), "relaxation" | "none") {
             return Err(format!("equilibrium.method \"{}\" is not \"relaxation\" or \"none\"", self.equilibrium.method));
+        }
+        if let Some(e) = &self.output.envelope {
+            if e.faces.is_empty() || e.stride == 0 {
+                return Err("output.envelope: give at least one face group in `faces` and a `stride` ≥ 1 [steps]".into());
+            }
         }
         if self.output.frame_stride.is_some() && self.output.frame_interval.is_some() {
             return Err("output: give `frame_stride` or `frame_interval`, not both".into());

@@ -6,6 +6,7 @@
 //! Invariants: every file is written whole (temp file + rename), and the `.pvd` is
 //! rewritten after every frame, so a run killed at any point leaves a readable series.
 
+pub mod envelope;
 pub mod frames;
 pub mod history;
 pub mod joints;

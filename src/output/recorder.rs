@@ -17,11 +17,13 @@
 //! - **Monitors**: the scene's points snapped to nodes ([`snap_monitors`]).
 //! - **Peaks**: |u|, |v|, |a| of any node, sampled every [`PEAK_STRIDE`] steps and at the last.
 //! - **Progress**: a bar on stderr when asked for and stderr is a terminal; nothing otherwise.
+//! - **Envelopes**: stress envelopes on face groups ([`super::envelope`], `output.envelope`).
 //! - **Summary**: [`Recorder::summary`] gathers the [`RunSummary`].
 //!
 //! Velocities and accelerations are the scheme's central differences at t[n]
 //! ([`crate::dynamics::Kinematics`]).
 
+use super::envelope::EnvelopeWriter;
 use super::frames::FrameWriter;
 use super::history::{HistoryWriter, Monitor};
 use super::joints::JointWriter;
@@ -166,6 +168,7 @@ pub struct Recorder {
     history: HistoryWriter,
     frames: Option<FrameWriter>,
     joints: Option<JointWriter>,
+    envelope: Option<EnvelopeWriter>,
     pub peaks: Peaks,
     frame_stride: usize,
     hist_stride: usize,
@@ -191,6 +194,7 @@ impl Recorder {
                 pk.gs_tolerance = if matches!(j.method, Method::Penalty { .. }) { 0.0 } else { c.gs_tolerance };
             }
         }
+        let envelope = match &scene.output.envelope { Some(spec) => Some(EnvelopeWriter::create(model, spec)?), None => None };
         let dt = sim.dt();
         let n_steps = sim.n_steps();
         let frame_stride = match (scene.output.frame_stride, scene.output.frame_interval) {
@@ -217,6 +221,7 @@ impl Recorder {
             history,
             frames,
             joints,
+            envelope,
             peaks: Peaks::default(),
             frame_stride,
             hist_stride: history_stride(&scene.output, dt, scene.time.duration),
@@ -348,6 +353,9 @@ impl Observer for Recorder {
         if let Some(f) = self.frames.as_mut() {
             f.write(&p.model, &kin)?;
         }
+        if let Some(e) = self.envelope.as_mut() {
+            e.sample(&p.model, kin.u, 0.0);
+        }
         if let Some(jw) = self.joints.as_mut() {
             jw.unsearched = sim.equilibrium.is_none();
             jw.record(0.0, &p.joints, &sim.state.contact, &sim.state.u)?;
@@ -378,6 +386,11 @@ impl Observer for Recorder {
         if self.history_due(k, last) {
             self.monitor_rows(&kin);
             self.history.row(kin.t, &self.rows);
+        }
+        if let Some(e) = self.envelope.as_mut() {
+            if k % e.stride == 0 || k == last {
+                e.sample(&p.model, kin.u, kin.t);
+            }
         }
         if k % PEAK_STRIDE == 0 || k == last {
             self.peaks.update(&p.model, &kin);
@@ -412,9 +425,12 @@ impl Observer for Recorder {
         self.stop
     }
 
-    fn finish(&mut self, _sim: &Simulation<'_>) -> Result<(), Error> {
+    fn finish(&mut self, sim: &Simulation<'_>) -> Result<(), Error> {
         self.bar.finish_and_clear();
         self.history.flush()?;
+        if let Some(e) = &self.envelope {
+            e.write(&sim.problem.model, &self.out_dir)?;
+        }
         if let Some(jw) = self.joints.as_mut() {
             jw.flush()?;
         }

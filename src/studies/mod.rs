@@ -2,12 +2,14 @@
 //! tables, charts and own steps), and the registry that picks the kind named by a study
 //! file's `report.kind`.
 //!
-//! Kinds: `wedge` ([`wedge`]: the Hoek & Bray wedge of the seed paper), `incline`
+//! Kinds: `wedge` ([`wedge`]: the Hoek & Bray wedge of the seed paper), `dam` ([`dam`]: the
+//! arch dam's contraction joints, NTS against NTN, seed section 5), `incline`
 //! ([`incline`]: a block on an incline against the rigid Newmark block), `joint_tests`
 //! ([`joint_tests`]: generated mismatched-mesh cases against exact references), `runs` (the run table
 //! only: any study). Adding a kind: a module here implementing [`StudyKind`] and a line in
 //! [`kind_of`] (docs/studies.md).
 
+pub mod dam;
 pub mod incline;
 pub mod joint_tests;
 pub mod wedge;
@@ -20,6 +22,7 @@ use std::fmt::Write as _;
 pub fn kind_of(study: &Study) -> Result<Box<dyn StudyKind>, Error> {
     Ok(match study.kind.as_str() {
         "wedge" => Box::new(wedge::WedgeKind::new(study)?),
+        "dam" => Box::new(dam::DamKind::new(study)?),
         "incline" => Box::new(incline::InclineKind::new(study)?),
         "joint_tests" => Box::new(joint_tests::JointTestsKind::new(study)?),
         "runs" => {
@@ -28,7 +31,7 @@ pub fn kind_of(study: &Study) -> Result<Box<dyn StudyKind>, Error> {
             }
             Box::new(RunsKind)
         }
-        other => return Err(StudyError::Invalid { path: study.path.clone(), message: format!("`report.kind` = \"{other}\" is not a study kind (kinds: wedge, incline, runs, joint_tests)") }.into()),
+        other => return Err(StudyError::Invalid { path: study.path.clone(), message: format!("`report.kind` = \"{other}\" is not a study kind (kinds: wedge, incline, dam, runs, joint_tests)") }.into()),
     })
 }
 

@@ -10,6 +10,7 @@ mod common;
 mod contact;
 mod contact_validation;
 mod dam_physics;
+mod dam_study;
 mod dynamics;
 mod fuzz;
 mod joint_tests;

@@ -148,8 +148,8 @@ fn study_file_errors_name_the_file_and_the_field() {
     let e = load_err(&dir, json!({"scene": "scene.json", "axes": [{"name": "m", "values": [0.2]}]}));
     assert!(e.contains("field"), "{e}");
     // an unknown kind, a kind's unknown parameter
-    let e = load_err(&dir, json!({"scene": "scene.json", "axes": axes, "report": {"kind": "dam"}}));
-    assert!(e.contains("\"dam\"") && e.contains("wedge, incline, runs"), "{e}");
+    let e = load_err(&dir, json!({"scene": "scene.json", "axes": axes, "report": {"kind": "dams"}}));
+    assert!(e.contains("\"dams\"") && e.contains("wedge, incline, dam, runs"), "{e}");
     let e = load_err(&dir, json!({"scene": "scene.json", "axes": axes, "report": {"kind": "incline", "beta": 30, "monitor": "slider", "joint": "J", "betta": 1}}));
     assert!(e.contains("kind \"incline\"") && e.contains("betta"), "{e}");
     let e = load_err(&dir, json!({"scene": "scene.json", "axes": axes, "report": {"kind": "incline", "beta": 30, "monitor": "slidr", "joint": "J"}}));

@@ -1,0 +1,300 @@
+//! Stress envelopes over time on face groups (scene `output.envelope`): for each face of the
+//! groups, the largest principal stress σ1 (tension positive) and the smallest σ3 (the most
+//! compressive) that the volume element under it reached during the run, with when.
+//!
+//! Sign convention: stresses in Pa, tension positive (as the frames' `principal_stress`).
+//! A face's value is its element's stress at the element centre (constant in a tet4, the
+//! centroid of a hex8: `Model::element_stress_into`), not extrapolated to the surface.
+//! Sampling: every `stride` steps from the first step (the static state at t ≈ 0 is included)
+//! and at the last step; a peak between two samples is missed by at most 1 − cos(π/n) for a
+//! response with n samples per period (stride 10 at dt 5.4e-4 s: 1.5 % at 10 Hz).
+//!
+//! Written at the end of the run: `envelope.vtu` (the faces, cell fields `max_principal`,
+//! `min_principal` [Pa], `max_principal_t`, `min_principal_t` [s], `group` = index in `faces`)
+//! for ParaView, and `envelope.json`, read back by [`StressEnvelope::read`].
+
+use crate::error::{ModelError, OutputError};
+use crate::model::Model;
+use crate::scene::EnvelopeSpec;
+use crate::vtk::vtu::{Field, Grid, write_vtu};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// An extreme value and where and when it happened.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Extreme {
+    /// Pa.
+    pub value: f64,
+    /// s.
+    pub t: f64,
+    /// Gmsh tag of the element.
+    pub element_tag: u64,
+    /// Centre of the face [m].
+    pub position: [f64; 3],
+}
+
+/// The envelope of one face group.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FaceEnvelope {
+    pub group: String,
+    /// Per face of the group: the element under it, in model order (the frames' cell order).
+    pub elements: Vec<usize>,
+    /// Per face: the largest σ1 [Pa] over the run.
+    pub max_principal: Vec<f64>,
+    /// Per face: the smallest σ3 [Pa] over the run.
+    pub min_principal: Vec<f64>,
+    /// The largest σ1 over the group (the largest tension when > 0).
+    pub max_tension: Extreme,
+    /// The smallest σ3 over the group (the largest compression when < 0).
+    pub max_compression: Extreme,
+}
+
+/// What `envelope.json` holds.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StressEnvelope {
+    /// Steps between samples.
+    pub stride: usize,
+    /// Samples taken.
+    pub samples: usize,
+    /// Time of the last sample [s].
+    pub t_last: f64,
+    pub faces: Vec<FaceEnvelope>,
+}
+
+impl StressEnvelope {
+    /// Read `envelope.json` (`path` is the file or the run directory).
+    pub fn read(path: &Path) -> Result<StressEnvelope, OutputError> {
+        let file = if path.is_dir() {
+            path.join("envelope.json")
+        } else {
+            path.to_path_buf()
+        };
+        let text = std::fs::read_to_string(&file).map_err(|e| OutputError::read(&file, e))?;
+        let env: StressEnvelope = serde_json::from_str(&text)
+            .map_err(|e| OutputError::read(&file, format!("not a stress envelope: {e}")))?;
+        for f in &env.faces {
+            if f.max_principal.len() != f.elements.len()
+                || f.min_principal.len() != f.elements.len()
+            {
+                return Err(OutputError::read(
+                    &file,
+                    format!(
+                        "face group \"{}\": {} elements but {} / {} values",
+                        f.group,
+                        f.elements.len(),
+                        f.max_principal.len(),
+                        f.min_principal.len()
+                    ),
+                ));
+            }
+        }
+        Ok(env)
+    }
+
+    /// The envelope of face group `group`.
+    pub fn face(&self, group: &str) -> Option<&FaceEnvelope> {
+        self.faces.iter().find(|f| f.group == group)
+    }
+}
+
+/// Tracks the envelopes while a run steps.
+pub struct EnvelopeWriter {
+    pub stride: usize,
+    groups: Vec<String>,
+    /// Per group: its face cells (mesh indices) and the model element under each.
+    faces: Vec<Vec<(usize, usize)>>,
+    /// Per model element: the running max σ1, min σ3 and their times (only those under a face).
+    max_s1: Vec<(f64, f64)>,
+    min_s3: Vec<(f64, f64)>,
+    samples: usize,
+    t_last: f64,
+    stress: Vec<[f64; 6]>,
+}
+
+impl EnvelopeWriter {
+    /// Find the element under every face of `spec.faces`. An unknown group, a group that is not
+    /// of faces, or a face that bounds no element is an error naming the group and the face.
+    pub fn create(model: &Model, spec: &EnvelopeSpec) -> Result<EnvelopeWriter, crate::Error> {
+        let mesh = &model.mesh;
+        let ne = model.n_elements();
+        // node → model elements
+        let mut of_node: Vec<Vec<u32>> = vec![Vec::new(); model.n_nodes()];
+        let nt = model.tets.nodes.len();
+        for (e, n) in model.tets.nodes.iter().enumerate() {
+            for &i in n {
+                of_node[i as usize].push(e as u32);
+            }
+        }
+        for (e, n) in model.hexes.nodes.iter().enumerate() {
+            for &i in n {
+                of_node[i as usize].push((nt + e) as u32);
+            }
+        }
+        let elem_nodes = |e: usize| -> &[u32] {
+            if e < nt {
+                &model.tets.nodes[e]
+            } else {
+                &model.hexes.nodes[e - nt]
+            }
+        };
+        let mut faces = Vec::new();
+        for g in &spec.faces {
+            let group = mesh.group_of_dim(g, 2)?;
+            let mut v = Vec::with_capacity(group.cells.len());
+            for &c in &group.cells {
+                let fnodes = mesh.cells[c].nodes();
+                let e = of_node[fnodes[0] as usize].iter().map(|&e| e as usize).find(|&e| fnodes.iter().all(|n| elem_nodes(e).contains(n))).ok_or_else(|| {
+                    ModelError::Invalid(format!("output.envelope: face {} of group \"{g}\" bounds no volume element (give a face group on the surface of a material volume)", mesh.cells[c].tag))
+                })?;
+                v.push((c, e));
+            }
+            faces.push(v);
+        }
+        Ok(EnvelopeWriter {
+            stride: spec.stride.max(1),
+            groups: spec.faces.clone(),
+            faces,
+            max_s1: vec![(f64::NEG_INFINITY, 0.0); ne],
+            min_s3: vec![(f64::INFINITY, 0.0); ne],
+            samples: 0,
+            t_last: 0.0,
+            stress: Vec::new(),
+        })
+    }
+
+    /// Sample the stresses of displacement `u` at time `t`.
+    pub fn sample(&mut self, model: &Model, u: &[f64], t: f64) {
+        model.element_stress_into(u, &mut self.stress);
+        for g in &self.faces {
+            for &(_, e) in g {
+                let p = super::principal_stresses(&self.stress[e]);
+                if p[0] > self.max_s1[e].0 {
+                    self.max_s1[e] = (p[0], t);
+                }
+                if p[2] < self.min_s3[e].0 {
+                    self.min_s3[e] = (p[2], t);
+                }
+            }
+        }
+        self.samples += 1;
+        self.t_last = t;
+    }
+
+    /// The envelope so far.
+    pub fn envelope(&self, model: &Model) -> StressEnvelope {
+        let mesh = &model.mesh;
+        let centre = |c: usize| {
+            let n = mesh.cells[c].nodes();
+            let mut x = [0.0; 3];
+            for &i in n {
+                for (k, xk) in x.iter_mut().enumerate() {
+                    *xk += mesh.nodes[i as usize][k] / n.len() as f64;
+                }
+            }
+            x
+        };
+        let tag = |e: usize| {
+            let nt = model.tets.nodes.len();
+            let cell = if e < nt {
+                model.tets.cell[e]
+            } else {
+                model.hexes.cell[e - nt]
+            };
+            mesh.cells[cell as usize].tag
+        };
+        let faces = self
+            .groups
+            .iter()
+            .zip(&self.faces)
+            .map(|(g, fs)| {
+                let (mut ten, mut com) = (
+                    Extreme {
+                        value: f64::NEG_INFINITY,
+                        ..Default::default()
+                    },
+                    Extreme {
+                        value: f64::INFINITY,
+                        ..Default::default()
+                    },
+                );
+                for &(c, e) in fs {
+                    if self.max_s1[e].0 > ten.value {
+                        ten = Extreme {
+                            value: self.max_s1[e].0,
+                            t: self.max_s1[e].1,
+                            element_tag: tag(e),
+                            position: centre(c),
+                        };
+                    }
+                    if self.min_s3[e].0 < com.value {
+                        com = Extreme {
+                            value: self.min_s3[e].0,
+                            t: self.min_s3[e].1,
+                            element_tag: tag(e),
+                            position: centre(c),
+                        };
+                    }
+                }
+                FaceEnvelope {
+                    group: g.clone(),
+                    elements: fs.iter().map(|&(_, e)| e).collect(),
+                    max_principal: fs.iter().map(|&(_, e)| self.max_s1[e].0).collect(),
+                    min_principal: fs.iter().map(|&(_, e)| self.min_s3[e].0).collect(),
+                    max_tension: ten,
+                    max_compression: com,
+                }
+            })
+            .collect();
+        StressEnvelope {
+            stride: self.stride,
+            samples: self.samples,
+            t_last: self.t_last,
+            faces,
+        }
+    }
+
+    /// Write `envelope.vtu` and `envelope.json` into `out_dir` (nothing if no sample was taken).
+    pub fn write(&self, model: &Model, out_dir: &Path) -> Result<Option<PathBuf>, OutputError> {
+        if self.samples == 0 {
+            return Ok(None);
+        }
+        let env = self.envelope(model);
+        let mesh = &model.mesh;
+        let (mut s1, mut s3, mut t1, mut t3, mut gid) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut cells = Vec::new();
+        for (k, fs) in self.faces.iter().enumerate() {
+            for &(c, e) in fs {
+                cells.push((mesh.cells[c].kind, mesh.cells[c].nodes()));
+                s1.push(self.max_s1[e].0);
+                s3.push(self.min_s3[e].0);
+                t1.push(self.max_s1[e].1);
+                t3.push(self.min_s3[e].1);
+                gid.push(k as i32);
+            }
+        }
+        let grid = Grid {
+            points: &mesh.nodes,
+            cells,
+        };
+        write_vtu(
+            &out_dir.join("envelope.vtu"),
+            &grid,
+            &[],
+            &[
+                Field::f64("max_principal", 1, &s1),
+                Field::f64("min_principal", 1, &s3),
+                Field::f64("max_principal_t", 1, &t1),
+                Field::f64("min_principal_t", 1, &t3),
+                Field::i32("group", 1, &gid),
+            ],
+        )?;
+        let p = out_dir.join("envelope.json");
+        std::fs::write(
+            &p,
+            serde_json::to_string(&env).expect("an envelope serialises"),
+        )
+        .map_err(|e| OutputError::write(&p, e))?;
+        Ok(Some(p))
+    }
+}

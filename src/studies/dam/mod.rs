@@ -1,0 +1,524 @@
+//! The arch dam study (seed paper section 5): the 28 contraction joints' opening and slip and
+//! the face stresses at 1×, 2×, 3× the design PGA with NTS and NTN, the monolithic dam, the
+//! coarse mesh and NTS-Layer2 as cheaper or reference levels.
+//!
+//! Its runs are plain study-file data (`pipelines/dam_study.json`); this module reads each run
+//! through the typed readers and makes the tables and charts ([`report`]).
+//!
+//! What it reads from a run: its level (the run's PGA over `design_pga`), its mesh label
+//! (`mesh_axis`), its method from its scene's contraction-joint entry (`joints`: tied → the
+//! monolithic dam; `ntn` → NTN; `nts` with `layer` 2 → NTS-Layer2, else NTS), per joint the
+//! largest opening and accumulated slip over the record (`histories/joint_<J>.csv`, columns
+//! `max_opening`, `max_slip`: also for a run that stopped, up to where it stopped), the search
+//! and Gauss–Seidel diagnostics per joint (`summary.json`), the face stress envelopes
+//! (`envelope.json`, [`crate::output::envelope`]) and the crest monitors' histories.
+//!
+//! Conventions: joints numbered 1… in the natural order of their names (J01 … J28, from the
+//! left bank); opening and slip in m (reported in mm); stresses in Pa (reported in MPa),
+//! tension positive; crest radial displacement positive downstream, along the horizontal
+//! normal of the upstream crest arch y = x² / (2 Rc) at the monitor, (−x/Rc, 1, 0) normalised.
+
+pub mod report;
+
+use crate::error::{Error, OutputError, StudyError};
+use crate::mesh::pattern::{GroupPattern, natural_cmp};
+use crate::output::envelope::{Extreme, StressEnvelope};
+use crate::output::history::HistoryTable;
+use crate::scene::{ContactMethod, Scene};
+use crate::study::{KindReport, RunResult, Study, StudyKind, StudyResults, kind_params};
+use serde::{Deserialize, Serialize};
+
+/// The dam study's parameters: the study file's `report` object (`"kind": "dam"`).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct DamParams {
+    /// Design PGA [g]; a run's level is its PGA over it. Default 0.5575 (the seed's dam).
+    #[serde(default = "design_pga")]
+    pub design_pga: f64,
+    /// Name of the scene's joint entry of the contraction joints (a pattern: `J{J}`).
+    #[serde(default = "joint_entry")]
+    pub joints: String,
+    /// The axis of mesh levels and the label of the main mesh.
+    #[serde(default = "mesh_axis")]
+    pub mesh_axis: String,
+    pub main_mesh: String,
+    /// Face groups of the stress envelopes.
+    #[serde(default)]
+    pub faces: Faces,
+    /// The scene's crest monitors.
+    #[serde(default)]
+    pub monitors: Monitors,
+    /// Crown radius Rc [m] of the upstream crest arch y = x² / (2 Rc) (the radial direction).
+    /// Default 270 (`geo/arch_dam.geo`).
+    #[serde(default = "crest_radius")]
+    pub crest_radius: f64,
+    /// Relative error within which a cheaper level "is enough". Default 0.10.
+    #[serde(default = "enough")]
+    pub enough: f64,
+    /// The seed paper's numbers the tables compare with.
+    pub seed: SeedNumbers,
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Faces {
+    pub upstream: String,
+    pub downstream: String,
+}
+
+impl Default for Faces {
+    fn default() -> Self {
+        Faces {
+            upstream: "face:upstream".into(),
+            downstream: "face:downstream".into(),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Monitors {
+    pub crown: String,
+    pub quarter_left: String,
+    pub quarter_right: String,
+}
+
+impl Default for Monitors {
+    fn default() -> Self {
+        Monitors {
+            crown: "crest_crown".into(),
+            quarter_left: "crest_quarter_left".into(),
+            quarter_right: "crest_quarter_right".into(),
+        }
+    }
+}
+
+/// The seed's published values (Zhong 2022, section 5), in the units it gives them.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeedNumbers {
+    /// Where the numbers come from.
+    pub source: String,
+    /// Levels (× design PGA) of the opening values.
+    pub levels: Vec<f64>,
+    /// Largest joint opening over all joints per level [mm].
+    pub opening_nts_mm: Vec<f64>,
+    pub opening_ntn_mm: Vec<f64>,
+    /// NTS's largest slip over NTN's at the highest level, minus 1 (0.088: NTS 8.8 % above).
+    pub slip_nts_over_ntn: f64,
+    /// Largest principal tension and compression at the highest level [MPa].
+    pub tension_nts_mpa: f64,
+    pub tension_ntn_mpa: f64,
+    pub compression_nts_mpa: f64,
+    pub compression_ntn_mpa: f64,
+}
+
+fn design_pga() -> f64 {
+    0.5575
+}
+fn joint_entry() -> String {
+    "J{J}".into()
+}
+fn mesh_axis() -> String {
+    "mesh".into()
+}
+fn crest_radius() -> f64 {
+    270.0
+}
+fn enough() -> f64 {
+    0.10
+}
+
+/// The contact model of a run's contraction joints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+pub enum Method {
+    #[serde(rename = "NTS")]
+    Nts,
+    #[serde(rename = "NTN")]
+    Ntn,
+    #[serde(rename = "NTS-Layer2")]
+    NtsLayer2,
+    #[serde(rename = "monolithic")]
+    Monolithic,
+    #[serde(rename = "penalty")]
+    Penalty,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Nts => "NTS",
+            Method::Ntn => "NTN",
+            Method::NtsLayer2 => "NTS-Layer2",
+            Method::Monolithic => "monolithic",
+            Method::Penalty => "penalty",
+        }
+    }
+}
+
+/// Search and Gauss–Seidel diagnostics of one joint over a run (`summary.json`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct JointDiagnostics {
+    pub lost: u64,
+    pub widened_layer2: u64,
+    pub fresh_searches: u64,
+    pub max_sweeps: usize,
+    pub unconverged_steps: u64,
+}
+
+/// The face stresses of one run: the envelope's extremes per face.
+#[derive(Clone, Debug, Serialize)]
+pub struct FaceStress {
+    pub upstream_tension: Extreme,
+    pub upstream_compression: Extreme,
+    pub downstream_tension: Extreme,
+    pub downstream_compression: Extreme,
+}
+
+impl FaceStress {
+    /// Largest tension over both faces [Pa].
+    pub fn tension(&self) -> f64 {
+        self.upstream_tension
+            .value
+            .max(self.downstream_tension.value)
+    }
+    /// Most compressive σ3 over both faces [Pa] (negative).
+    pub fn compression(&self) -> f64 {
+        self.upstream_compression
+            .value
+            .min(self.downstream_compression.value)
+    }
+}
+
+/// What the report uses of one run.
+#[derive(Clone, Debug, Serialize)]
+pub struct DamRun {
+    pub id: String,
+    pub method: Method,
+    /// PGA over the design PGA.
+    pub level: f64,
+    pub mesh: String,
+    /// Wall time [s] (finished runs).
+    pub wall_time: Option<f64>,
+    /// The error of a run that stopped (its histories end there).
+    pub failed: Option<String>,
+    /// Record time reached [s] (last joint-history row).
+    pub t_end: f64,
+    pub joints: Vec<String>,
+    /// Per joint: largest opening and accumulated slip over the record [m].
+    pub opening: Vec<f64>,
+    pub slip: Vec<f64>,
+    /// Per joint (finished runs).
+    pub diagnostics: Option<Vec<JointDiagnostics>>,
+    /// From `envelope.json` (finished runs that asked for it).
+    pub stress: Option<FaceStress>,
+    /// Crest radial displacement histories (crown, left and right quarter points): (t, u_r) [s, m].
+    #[serde(skip)]
+    pub crest: Vec<(String, Vec<(f64, f64)>)>,
+    /// The opening history (largest over the joint) of the joint with the largest opening.
+    #[serde(skip)]
+    pub worst_joint_history: Vec<(f64, f64)>,
+}
+
+impl DamRun {
+    pub fn max_opening(&self) -> (usize, f64) {
+        argmax(&self.opening)
+    }
+    pub fn max_slip(&self) -> (usize, f64) {
+        argmax(&self.slip)
+    }
+    pub fn is_main(&self, p: &DamParams) -> bool {
+        self.mesh == p.main_mesh
+    }
+}
+
+/// (index, value) of the largest value (the first on ties; (0, −∞) when empty).
+pub fn argmax(v: &[f64]) -> (usize, f64) {
+    v.iter().copied().enumerate().fold(
+        (0, f64::NEG_INFINITY),
+        |a, (i, x)| if x > a.1 { (i, x) } else { a },
+    )
+}
+
+pub struct DamKind {
+    pub params: DamParams,
+}
+
+impl DamKind {
+    pub fn new(study: &Study) -> Result<DamKind, Error> {
+        let params: DamParams = kind_params(study)?;
+        let k = DamKind { params };
+        k.check(study)?;
+        Ok(k)
+    }
+
+    /// The contact model of a scene's contraction joints.
+    fn method_of(&self, scene: &Scene) -> Result<Method, String> {
+        let j = scene
+            .joints
+            .iter()
+            .find(|j| j.name == self.params.joints)
+            .ok_or_else(|| {
+                format!(
+                    "its scene has no joint entry \"{}\" (entries: {})",
+                    self.params.joints,
+                    scene
+                        .joints
+                        .iter()
+                        .map(|j| j.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            })?;
+        Ok(
+            match (
+                j.tied.unwrap_or(false),
+                j.method.unwrap_or(ContactMethod::Nts),
+                j.layer.unwrap_or(1),
+            ) {
+                (true, _, _) => Method::Monolithic,
+                (false, ContactMethod::Ntn, _) => Method::Ntn,
+                (false, ContactMethod::Penalty, _) => Method::Penalty,
+                (false, ContactMethod::Nts, 2) => Method::NtsLayer2,
+                (false, ContactMethod::Nts, _) => Method::Nts,
+            },
+        )
+    }
+
+    /// The contraction joints' names in a run directory (from its joint histories), in natural order.
+    fn joint_names(&self, r: &RunResult) -> Result<Vec<String>, OutputError> {
+        let pat = GroupPattern::parse(&self.params.joints).map_err(|e| {
+            OutputError::read(
+                &r.dir,
+                format!("`joints` = \"{}\": {e}", self.params.joints),
+            )
+        })?;
+        let dir = r.dir.join("histories");
+        let rd = std::fs::read_dir(&dir).map_err(|e| OutputError::read(&dir, e))?;
+        let mut names: Vec<String> = rd
+            .filter_map(|e| e.ok())
+            .filter_map(|e| {
+                e.file_name()
+                    .to_str()
+                    .and_then(|n| n.strip_prefix("joint_"))
+                    .and_then(|n| n.strip_suffix(".csv"))
+                    .map(str::to_string)
+            })
+            .filter(|n| matches!(pat.match_name(n), Ok(Some(_))))
+            .collect();
+        names.sort_by(|a, b| natural_cmp(a, b));
+        if names.is_empty() {
+            return Err(OutputError::read(
+                &dir,
+                format!("no joint history matches \"{}\"", self.params.joints),
+            ));
+        }
+        Ok(names)
+    }
+
+    /// Crest radial displacement of monitor `name`: (t, u · n_r).
+    fn crest_history(&self, r: &RunResult, name: &str) -> Result<Vec<(f64, f64)>, OutputError> {
+        let h: HistoryTable = r.history(name)?;
+        let pos = r.summary.as_ref().and_then(|s| {
+            s.monitors
+                .iter()
+                .find(|m| m.name == name)
+                .map(|m| m.position)
+        });
+        let x = match (
+            pos,
+            r.scene
+                .as_ref()
+                .and_then(|s| s.output.monitor.iter().find(|m| m.name == name)),
+        ) {
+            (Some(p), _) => p[0],
+            (None, Some(m)) => m.point[0],
+            (None, None) => {
+                return Err(OutputError::read(
+                    &h.path,
+                    format!("the run's scene has no monitor \"{name}\""),
+                ));
+            }
+        };
+        let (nx, ny) = (-x / self.params.crest_radius, 1.0);
+        let n = nx.hypot(ny);
+        let (t, ux, uy) = (h.column("t")?, h.column("ux")?, h.column("uy")?);
+        Ok((0..h.len())
+            .map(|i| (t[i], (ux[i] * nx + uy[i] * ny) / n))
+            .collect())
+    }
+
+    /// Read one run.
+    pub fn run(&self, r: &RunResult) -> Result<DamRun, Error> {
+        let p = &self.params;
+        let scene = r
+            .scene
+            .as_ref()
+            .ok_or_else(|| OutputError::read(&r.dir, "its scene cannot be read"))?;
+        let method = self
+            .method_of(scene)
+            .map_err(|m| OutputError::read(&r.dir, m))?;
+        let pga = r.spec.pga.ok_or_else(|| {
+            OutputError::read(
+                &r.dir,
+                "the run sets no `pga` (the level axis must set `pga`)",
+            )
+        })?;
+        let mesh = r
+            .spec
+            .label(&p.mesh_axis)
+            .unwrap_or(&p.main_mesh)
+            .to_string();
+        let joints = self.joint_names(r)?;
+        let (mut opening, mut slip) = (Vec::new(), Vec::new());
+        let mut t_end = 0.0f64;
+        let mut worst: Option<(f64, Vec<(f64, f64)>)> = None;
+        for j in &joints {
+            let h = r.joint_history(j)?;
+            let (t, o, s) = (
+                h.column("t")?,
+                h.column("max_opening")?,
+                h.column("max_slip")?,
+            );
+            let mo = o.iter().copied().fold(0.0f64, f64::max);
+            opening.push(mo);
+            slip.push(s.iter().copied().fold(0.0f64, f64::max));
+            t_end = t_end.max(t.last().copied().unwrap_or(0.0));
+            if worst.as_ref().is_none_or(|w| mo > w.0) {
+                worst = Some((mo, t.iter().copied().zip(o.iter().copied()).collect()));
+            }
+        }
+        let diagnostics = r.summary.as_ref().map(|s| {
+            joints
+                .iter()
+                .map(|j| {
+                    s.joints
+                        .iter()
+                        .find(|pk| &pk.name == j)
+                        .map(|pk| JointDiagnostics {
+                            lost: pk.events.lost,
+                            widened_layer2: pk.events.widened_layer2,
+                            fresh_searches: pk.events.fresh_searches,
+                            max_sweeps: pk.max_sweeps,
+                            unconverged_steps: pk.unconverged_steps,
+                        })
+                        .unwrap_or_default()
+                })
+                .collect()
+        });
+        let stress = if r.failed().is_none() {
+            let env = StressEnvelope::read(&r.dir)?;
+            let face = |g: &str| {
+                env.face(g).ok_or_else(|| OutputError::read(r.dir.join("envelope.json"), format!("no envelope of face group \"{g}\" (the scene's `output.envelope.faces` must name it)")))
+            };
+            let (u, d) = (face(&p.faces.upstream)?, face(&p.faces.downstream)?);
+            Some(FaceStress {
+                upstream_tension: u.max_tension.clone(),
+                upstream_compression: u.max_compression.clone(),
+                downstream_tension: d.max_tension.clone(),
+                downstream_compression: d.max_compression.clone(),
+            })
+        } else {
+            None
+        };
+        let mut crest = Vec::new();
+        for m in [
+            &p.monitors.crown,
+            &p.monitors.quarter_left,
+            &p.monitors.quarter_right,
+        ] {
+            crest.push((m.clone(), self.crest_history(r, m)?));
+        }
+        Ok(DamRun {
+            id: r.spec.id.clone(),
+            method,
+            level: pga / p.design_pga,
+            mesh,
+            wall_time: r.summary.as_ref().map(|s| s.wall_time),
+            failed: r.failed().map(str::to_string),
+            t_end,
+            joints,
+            opening,
+            slip,
+            diagnostics,
+            stress,
+            crest,
+            worst_joint_history: worst.map(|w| w.1).unwrap_or_default(),
+        })
+    }
+}
+
+impl StudyKind for DamKind {
+    fn check(&self, study: &Study) -> Result<(), Error> {
+        let p = &self.params;
+        let invalid = |message: String| -> Error {
+            StudyError::Invalid {
+                path: study.path.clone(),
+                message: format!("`report` (kind \"dam\"): {message}"),
+            }
+            .into()
+        };
+        if !(p.design_pga.is_finite() && p.design_pga > 0.0) {
+            return Err(invalid(format!(
+                "`design_pga` = {} must be positive [g]",
+                p.design_pga
+            )));
+        }
+        if !(p.crest_radius.is_finite() && p.crest_radius > 0.0) {
+            return Err(invalid(format!(
+                "`crest_radius` = {} must be positive [m]",
+                p.crest_radius
+            )));
+        }
+        if !(p.enough.is_finite() && p.enough > 0.0) {
+            return Err(invalid(format!("`enough` = {} must be positive", p.enough)));
+        }
+        let s = &p.seed;
+        if s.opening_nts_mm.len() != s.levels.len() || s.opening_ntn_mm.len() != s.levels.len() {
+            return Err(invalid(format!(
+                "`seed`: {} levels but {} NTS and {} NTN openings",
+                s.levels.len(),
+                s.opening_nts_mm.len(),
+                s.opening_ntn_mm.len()
+            )));
+        }
+        if let Some(a) = study.axes.iter().find(|a| a.name == p.mesh_axis) {
+            if !a.values.iter().any(|v| v.label == p.main_mesh) {
+                return Err(invalid(format!(
+                    "`main_mesh` = \"{}\" is not a label of axis \"{}\"",
+                    p.main_mesh, p.mesh_axis
+                )));
+            }
+        }
+        let base = Scene::load(&study.scene)?;
+        self.method_of(&base)
+            .map_err(|m| invalid(format!("`joints`: {m}")))?;
+        for m in [
+            &p.monitors.crown,
+            &p.monitors.quarter_left,
+            &p.monitors.quarter_right,
+        ] {
+            if !base.output.monitor.iter().any(|x| &x.name == m) {
+                return Err(invalid(format!(
+                    "`monitors`: the base scene has no monitor \"{m}\""
+                )));
+            }
+        }
+        match &base.output.envelope {
+            Some(e)
+                if e.faces.contains(&p.faces.upstream) && e.faces.contains(&p.faces.downstream) => {
+            }
+            _ => {
+                return Err(invalid(format!(
+                    "the base scene's `output.envelope.faces` must name \"{}\" and \"{}\" (the stress envelopes the report reads)",
+                    p.faces.upstream, p.faces.downstream
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn report(&self, results: &StudyResults) -> Result<KindReport, Error> {
+        report::report(self, results)
+    }
+}

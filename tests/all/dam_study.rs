@@ -1,0 +1,280 @@
+//! The arch dam study (src/studies/dam/, pipelines/dam_study.json) in small: the base scene of
+//! the study on the committed coarse fixture, NTS and NTN at one small level, planned, run
+//! through the study's own runs.mk with `make` and reported.
+use crate::common::{fixture, scratch};
+use jointquake::output::envelope::StressEnvelope;
+use jointquake::study::{write_plan, write_report};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+fn manifest(p: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(p)
+}
+
+/// Record time of the test runs [s]. The issue wishes 2 s: that is about 3500 steps of the coarse
+/// dam at 33–59 ms a step (its joints do not converge within the Gauss–Seidel sweep budget at the
+/// solver's default tolerance, docs/dam.md "Benchmark"), 2–3.5 CPU-minutes per run, over the
+/// minute a test may take; 0.2 s (about 350 steps) keeps both runs near 20 CPU-seconds each.
+const DURATION: f64 = 0.2;
+
+/// The study's base scene on the coarse fixture, records by absolute path, `duration` of
+/// record, a frame only at the start and the end.
+fn dam_scene(duration: f64) -> Value {
+    let mut s: Value = serde_json::from_str(
+        &std::fs::read_to_string(manifest("pipelines/dam_study_base.json")).unwrap(),
+    )
+    .unwrap();
+    s["geometry"] = json!({"msh": fixture("arch_dam_coarse.msh")});
+    for b in s["loads"]["base"].as_array_mut().unwrap() {
+        let rec = manifest("pipelines").join(b["record"].as_str().unwrap());
+        b["record"] = json!(rec);
+    }
+    s["time"]["duration"] = json!(duration);
+    // no static state: the relaxation of gravity and the hydrostatic load with 28 frictional
+    // joints takes minutes of CPU on the coarse dam (docs/dam.md, "Seismic study"); the test is
+    // of the study's reading and reporting, and of NTS against NTN from the same start
+    s["loads"].as_object_mut().unwrap().remove("gravity");
+    s["reservoir"]["hydrostatic"] = json!(false);
+    s["equilibrium"] = json!({"method": "none"});
+    s["output"]["frames"] = json!(true);
+    s["output"]["frame_interval"] = json!(duration);
+    s
+}
+
+/// The cell field `name` of a VTU frame (vtkio).
+fn vtu_cell_field(path: &Path, name: &str) -> Vec<f64> {
+    use vtkio::model::{Attribute, DataSet};
+    let vtk = vtkio::Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
+        panic!("{}: not an unstructured grid", path.display())
+    };
+    let piece = pieces
+        .into_iter()
+        .next()
+        .unwrap()
+        .into_loaded_piece_data(None)
+        .unwrap();
+    for a in piece.data.cell {
+        if let Attribute::DataArray(d) = a {
+            if d.name == name {
+                return d.data.cast_into::<f64>().unwrap();
+            }
+        }
+    }
+    panic!("{}: no cell field {name}", path.display())
+}
+
+#[test]
+fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_from_the_runs() {
+    // NTS and NTN on the 28 joints of the coarse dam at 0.1 × the design PGA for DURATION s,
+    // from rest without the static state (see `dam_scene`), with the reservoir's added mass.
+    // References and tolerances:
+    // - at small input the joints barely open or slide (tens of µm), so the two contact
+    //   methods carry nearly the same forces: over the time both ran, the crown's largest
+    //   radial displacement within 1 % (measured: equal to 6 digits) and the largest opening and
+    //   slip over all joints within 10 % (measured 2.2 % and 3.4 %; the methods differ in where
+    //   the force acts on the master side, node O against the projection);
+    // - opening ≥ 0 and slip ≥ 0 by definition (max(gap, 0), an accumulated path);
+    // - the envelope is sampled at the last step too, so it bounds the last frame's principal
+    //   stresses exactly (to round-off, 1e-9 relative).
+    let dir = scratch("dam_study/small");
+    std::fs::write(
+        dir.join("scene.json"),
+        serde_json::to_string_pretty(&dam_scene(DURATION)).unwrap(),
+    )
+    .unwrap();
+    let mut study: Value = serde_json::from_str(
+        &std::fs::read_to_string(manifest("pipelines/dam_study.json")).unwrap(),
+    )
+    .unwrap();
+    study["name"] = json!("dam_small");
+    study["scene"] = json!("scene.json");
+    study["out"] = json!("out");
+    study["all"] = json!({});
+    study["axes"] = json!([
+        {"name": "level", "values": [{"label": "0.1x", "pga": 0.05575}]},
+        {"name": "method", "values": [
+            {"label": "nts", "joint": {"J{J}": {"method": "nts", "layer": 1}}},
+            {"label": "ntn", "joint": {"J{J}": {"method": "ntn"}}}
+        ]}
+    ]);
+    study["id"] = json!(["method", "level"]);
+    study.as_object_mut().unwrap().remove("runs");
+    let p = dir.join("study.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&study).unwrap()).unwrap();
+    let (study, kind) = jointquake::studies::load(&p).unwrap();
+    let files = write_plan(
+        &study,
+        &kind.steps(),
+        &dir.join("cache"),
+        env!("CARGO_BIN_EXE_jointquake"),
+    )
+    .unwrap();
+    assert_eq!(files.scenes.len(), 2);
+    let o = std::process::Command::new("make")
+        .args(["-s", "-j2", "-f"])
+        .arg(&files.makefile)
+        .arg("all")
+        .output()
+        .expect("make runs");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "make: {stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let r = write_report(&study, kind.as_ref()).unwrap();
+    assert!(r.problems.is_empty(), "{:?}", r.problems);
+    let doc: Value = serde_json::from_str(&std::fs::read_to_string(&r.json).unwrap()).unwrap();
+    let runs = doc["report"]["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2, "{runs:?}");
+    let get = |m: &str| {
+        runs.iter()
+            .find(|x| x["method"] == m)
+            .unwrap_or_else(|| panic!("no {m} run: {runs:?}"))
+    };
+    let (nts, ntn) = (get("NTS"), get("NTN"));
+    let vec = |x: &Value, k: &str| -> Vec<f64> {
+        x[k].as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    assert!(nts["failed"].is_null(), "NTS finishes: {nts}");
+    for x in [nts, ntn] {
+        let (o, s) = (vec(x, "opening"), vec(x, "slip"));
+        assert_eq!(o.len(), 28, "28 joints");
+        assert!(
+            o.iter().chain(&s).all(|&v| v.is_finite() && v >= 0.0),
+            "opening and slip ≥ 0: {x}"
+        );
+        // the joint envelopes (per-joint histories of the largest opening and slip) are written
+        let id = x["id"].as_str().unwrap();
+        for j in 1..=28 {
+            assert!(
+                dir.join(format!("out/runs/{id}/histories/joint_J{j:02}.csv"))
+                    .exists(),
+                "{id}: J{j:02}"
+            );
+        }
+    }
+    // NTS against NTN over the time both ran (NTN may stop: on this coarse mesh its pairs are
+    // up to 10 m apart, docs/dam.md, and a stopped run is named in the report; measured: NTN
+    // stops at 0.068 s on the energy balance, 7.4 % against the 5 % limit, from rest at 0.1×)
+    let t_common = nts["t_end"]
+        .as_f64()
+        .unwrap()
+        .min(ntn["t_end"].as_f64().unwrap());
+    assert!(t_common > 0.03, "both ran for a while: {t_common} s");
+    let res = jointquake::study::StudyResults::read(&study).unwrap();
+    let dk = jointquake::studies::dam::DamKind::new(&study).unwrap();
+    let upto = |id: &str| -> (f64, f64, f64) {
+        let r = res.run(id).unwrap();
+        let (mut o, mut s) = (0.0f64, 0.0f64);
+        for j in 1..=28 {
+            let h = r.joint_history(&format!("J{j:02}")).unwrap();
+            let (t, mo, ms) = (
+                h.column("t").unwrap(),
+                h.column("max_opening").unwrap(),
+                h.column("max_slip").unwrap(),
+            );
+            for i in (0..h.len()).filter(|&i| t[i] <= t_common) {
+                o = o.max(mo[i]);
+                s = s.max(ms[i]);
+            }
+        }
+        let crown = dk.run(r).unwrap().crest[0]
+            .1
+            .iter()
+            .filter(|x| x.0 <= t_common)
+            .map(|x| x.1.abs())
+            .fold(0.0, f64::max);
+        (o, s, crown)
+    };
+    let (a, b) = (
+        upto(nts["id"].as_str().unwrap()),
+        upto(ntn["id"].as_str().unwrap()),
+    );
+    eprintln!(
+        "up to t = {t_common:.4} s: largest opening NTS {:.4e} NTN {:.4e} m, slip {:.4e} {:.4e} m, crown |u_r| {:.6e} {:.6e} m",
+        a.0, b.0, a.1, b.1, a.2, b.2
+    );
+    assert!(
+        a.2 > 0.0 && (a.2 / b.2 - 1.0).abs() < 0.01,
+        "crown: {a:?} {b:?}"
+    );
+    assert!(
+        a.0 > 0.0 && (a.0 / b.0 - 1.0).abs() < 0.10,
+        "opening: {a:?} {b:?}"
+    );
+    assert!(
+        a.1 > 0.0 && (a.1 / b.1 - 1.0).abs() < 0.10,
+        "slip: {a:?} {b:?}"
+    );
+    // the stress envelope bounds the last frame's principal stresses (finished runs)
+    for x in [nts, ntn].into_iter().filter(|x| x["failed"].is_null()) {
+        let id = x["id"].as_str().unwrap();
+        let run = dir.join(format!("out/runs/{id}"));
+        let env = StressEnvelope::read(&run).unwrap();
+        assert_eq!(env.faces.len(), 2);
+        let frames: Vec<PathBuf> = {
+            let mut v: Vec<PathBuf> = std::fs::read_dir(run.join("frames"))
+                .unwrap()
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|e| e == "vtu"))
+                .collect();
+            v.sort();
+            v
+        };
+        let last = frames.last().expect("a last frame");
+        let ps = vtu_cell_field(last, "principal_stress");
+        let mut checked = 0;
+        for f in &env.faces {
+            assert!(
+                f.max_tension.value >= f.max_compression.value,
+                "{}",
+                f.group
+            );
+            for (k, &e) in f.elements.iter().enumerate() {
+                let (s1, s3) = (ps[3 * e], ps[3 * e + 2]);
+                let tol = 1e-9 * s1.abs().max(s3.abs()).max(1.0);
+                assert!(
+                    f.max_principal[k] >= s1 - tol && f.min_principal[k] <= s3 + tol,
+                    "{id} {}: element {e}: envelope [{}, {}] against the last frame [{s3}, {s1}]",
+                    f.group,
+                    f.min_principal[k],
+                    f.max_principal[k]
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 100, "{checked} faces checked");
+        assert!(run.join("envelope.vtu").exists());
+    }
+    // the report's tables are filled from the runs
+    let md = std::fs::read_to_string(&r.report).unwrap();
+    let f = |v: f64| jointquake::report::fmt_sig(1e3 * v, 4);
+    let largest = |x: &Value| vec(x, "opening").into_iter().fold(0.0, f64::max);
+    let row = md
+        .lines()
+        .find(|l| l.starts_with("| 0.1×") && l.contains(&f(largest(nts))))
+        .unwrap_or_else(|| panic!("the opening table has NTS's {} mm:\n{md}", f(largest(nts))));
+    assert!(row.contains(&f(largest(ntn))), "and NTN's: {row}");
+    if !ntn["failed"].is_null() {
+        assert!(
+            row.contains("stopped at") && md.contains("**failed**"),
+            "a stopped run is named: {md}"
+        );
+    }
+    assert!(
+        md.contains("## The seed's claims against our numbers")
+            && md.contains("## Speed against accuracy"),
+        "{md}"
+    );
+    assert!(
+        r.charts.iter().all(|c| c.exists()) && r.charts.len() >= 4,
+        "{:?}",
+        r.charts
+    );
+}
