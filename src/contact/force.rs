@@ -551,7 +551,16 @@ impl ContactSolver<'_> {
                         // that face: the full search would choose it too (selection rules of
                         // `select_projection`: nearest sheet, inside before edge, face id).
                         let mut found = None;
-                        if pr.face >= 0 {
+                        if pr.face >= 0 && j.law.tied {
+                            // A tied pair keeps the face it was tied to (a tie is made once and
+                            // kept, as tied contact does in LS-DYNA or Abaqus): the node is
+                            // projected on that face whatever its location (no inside test), so
+                            // a bonded node that a shear force carries dt² F / m past the face's
+                            // edge in the prediction is not lost (regression:
+                            // `tied_pure_shear_keeps_perimeter_nodes_at_the_default_edge_tolerance`).
+                            let f = pr.face as usize;
+                            found = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
+                        } else if pr.face >= 0 {
                             let f = pr.face as usize;
                             if let Some((p, edge2)) = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
                                 && p.location == Location::Inside
