@@ -4,17 +4,19 @@
 //! The same scheme as [`super::relax_gravity`] (undamped mass, α = 2 ω_min from the Rayleigh
 //! quotient, the constraints after each prediction), with gravity kept at its full value from
 //! the first step (the state already carries it) and only the static forces (the reservoir's
-//! hydrostatic pressure) ramped in over [`super::RELAXATION_RAMP_STEPS`] steps. Residual:
+//! hydrostatic pressure) ramped in over `ramp_steps` steps ([`super::RELAXATION_RAMP_STEPS`]
+//! from rest; 0 when the state already carries them, e.g. from a linear solve). Residual:
 //! ‖M (a + α v_b)‖ over the free components, relative to ‖F_gravity + F_static‖ (the whole load
 //! the state must now carry).
 
-use super::{Constraints, EquilibriumInfo, ExplicitSolver, Stage, State, RELAXATION_RAMP_STEPS};
+use super::{Constraints, EquilibriumInfo, ExplicitSolver, Stage, State};
 use crate::dynamics::loads::Loads;
 use crate::error::StepError;
 use crate::model::Model;
 
-/// Relax `state` (in equilibrium under gravity alone) to equilibrium under gravity plus the
-/// static forces of `loads`, ramped in; `tol` and `max_steps` as for relaxation.
+/// Relax `state` (in equilibrium under gravity alone, or already near the whole load) to
+/// equilibrium under gravity plus the static forces of `loads`, ramped in over `ramp_steps`
+/// steps (0: the whole load from the first step); `tol` and `max_steps` as for relaxation.
 pub fn relax_static_increment(
     model: &Model,
     loads: &Loads,
@@ -23,6 +25,7 @@ pub fn relax_static_increment(
     constraints: Constraints<'_, '_>,
     tol: f64,
     max_steps: usize,
+    ramp_steps: usize,
 ) -> Result<EquilibriumInfo, StepError> {
     let mut f_all = vec![0.0; 3 * model.n_nodes()];
     loads.external_force_into(model, 0.0, true, false, &mut f_all);
@@ -35,7 +38,7 @@ pub fn relax_static_increment(
     let mut residual = f64::INFINITY;
     let mut alpha = 0.0;
     for k in 0..max_steps {
-        let scale = ((k + 1) as f64 / RELAXATION_RAMP_STEPS as f64).min(1.0);
+        let scale = if ramp_steps == 0 { 1.0 } else { ((k + 1) as f64 / ramp_steps as f64).min(1.0) };
         for (s, f) in stage.static_forces.iter_mut().zip(&loads.static_forces) {
             s.1 = f.1.map(|v| v * scale);
         }
@@ -74,7 +77,7 @@ pub fn relax_static_increment(
         if umu > 0.0 && ukb > 0.0 {
             alpha = (2.0 * (ukb / umu).sqrt()).min(0.5 / dt);
         }
-        if residual < tol && k + 1 >= RELAXATION_RAMP_STEPS {
+        if residual < tol && k + 1 >= ramp_steps {
             state.u_prev.copy_from_slice(&state.u);
             return Ok(EquilibriumInfo { steps: k + 1, residual, converged: true });
         }
