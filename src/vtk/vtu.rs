@@ -58,18 +58,10 @@ pub struct Grid<'a> {
 /// (docs/performance.md §7): most of the size gain of level 6 for a fraction of its time.
 pub const ZLIB_LEVEL: u32 = 1;
 
-/// Standard base64 (RFC 4648, with padding) of `bytes`, appended to `out`.
+/// Standard base64 (RFC 4648, with padding) of `bytes`, appended to `out` (the `base64` crate).
 fn base64_into(bytes: &[u8], out: &mut String) {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    out.reserve(bytes.len().div_ceil(3) * 4);
-    for c in bytes.chunks(3) {
-        let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
-        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-        out.push(A[(n >> 18) as usize & 63] as char);
-        out.push(A[(n >> 12) as usize & 63] as char);
-        out.push(if c.len() > 1 { A[(n >> 6) as usize & 63] as char } else { '=' });
-        out.push(if c.len() > 2 { A[n as usize & 63] as char } else { '=' });
-    }
+    use base64::Engine as _;
+    base64::engine::general_purpose::STANDARD.encode_string(bytes, out);
 }
 
 /// One `<DataArray>` of the little-endian bytes `raw`, zlib-compressed in VTK's block layout
@@ -176,4 +168,66 @@ pub fn write_vtu_labelled(path: &Path, grid: &Grid, point_fields: &[Field], cell
     std::fs::write(&tmp, x).map_err(|e| OutputError::write(&tmp, e))?;
     std::fs::rename(&tmp, path).map_err(|e| OutputError::write(path, e))?;
     Ok(())
+}
+
+/// Read back the Float64 `<DataArray>` named `name` (point or cell data) of a VTU written by
+/// [`write_vtu`] (binary, one zlib block, UInt64 header): its values, row-major. The reader next
+/// to the writer, for the project's own checks (ParaView and meshio read the files as they are).
+pub fn read_vtu_f64_array(path: &Path, name: &str) -> Result<Vec<f64>, OutputError> {
+    use base64::Engine as _;
+    use std::io::Read as _;
+    let bad = |m: String| OutputError::read(path, m);
+    let text = std::fs::read_to_string(path).map_err(|e| OutputError::read(path, e))?;
+    let key = format!("type=\"Float64\" Name=\"{name}\"");
+    let start = text.find(&key).ok_or_else(|| bad(format!("no Float64 array \"{name}\"")))?;
+    let body = &text[start..];
+    let open = body.find('>').ok_or_else(|| bad(format!("array \"{name}\" has no content")))? + 1;
+    let close = body.find("</DataArray>").ok_or_else(|| bad(format!("array \"{name}\" is not closed")))?;
+    let data = body.get(open..close).ok_or_else(|| bad(format!("array \"{name}\" is malformed")))?.trim();
+    let b64 = base64::engine::general_purpose::STANDARD;
+    // an empty array is a header of 3 zero UInt64 (no block): 32 characters
+    if data.len() == 32 {
+        let h = b64.decode(data).map_err(|e| bad(format!("array \"{name}\": header: {e}")))?;
+        return if h.iter().all(|&b| b == 0) { Ok(Vec::new()) } else { Err(bad(format!("array \"{name}\": a header without data"))) };
+    }
+    // the header [blocks, block size, last block size, compressed size] is 4 UInt64 (32 bytes):
+    // 44 base64 characters on their own, then the zlib stream
+    let (h, z) = (data.get(..44).ok_or_else(|| bad(format!("array \"{name}\": header cut")))?, &data[44..]);
+    let header = b64.decode(h).map_err(|e| bad(format!("array \"{name}\": header: {e}")))?;
+    let raw_len = u64::from_le_bytes(header.get(8..16).and_then(|b| b.try_into().ok()).ok_or_else(|| bad(format!("array \"{name}\": header of {} bytes", header.len())))?);
+    if raw_len == 0 {
+        return Ok(Vec::new());
+    }
+    let stream = b64.decode(z).map_err(|e| bad(format!("array \"{name}\": data: {e}")))?;
+    // never allocate from the file's count: the decompressed size is bounded by the stream read
+    let mut raw = Vec::new();
+    flate2::read::ZlibDecoder::new(stream.as_slice()).read_to_end(&mut raw).map_err(|e| bad(format!("array \"{name}\": zlib: {e}")))?;
+    if raw.len() as u64 != raw_len || raw.len() % 8 != 0 {
+        return Err(bad(format!("array \"{name}\": {} bytes, header says {raw_len}", raw.len())));
+    }
+    Ok(raw.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A written array reads back bit for bit (point and cell data), and a missing one is named.
+    #[test]
+    fn written_arrays_read_back() {
+        let dir = std::env::temp_dir().join(format!("jq_vtu_rt_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.vtu");
+        let points = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let tet = [0u32, 1, 2, 3];
+        let grid = Grid { points: &points, cells: vec![(CellKind::Tet4, &tet[..])] };
+        let u: Vec<f64> = (0..12).map(|i| i as f64 * 0.1 - 0.35).collect();
+        let s = [1.5e6, -2.0e-300, f64::MAX, 0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
+        write_vtu(&path, &grid, &[Field::f64("u", 3, &u)], &[Field::f64("stress", 9, &s), Field::f64("empty_name_check", 1, &[7.0])]).unwrap();
+        assert_eq!(read_vtu_f64_array(&path, "u").unwrap(), u);
+        assert_eq!(read_vtu_f64_array(&path, "stress").unwrap(), s.to_vec());
+        let e = read_vtu_f64_array(&path, "strain").unwrap_err().to_string();
+        assert!(e.contains("\"strain\"") && e.contains("t.vtu"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -41,27 +41,9 @@ fn dam_scene(duration: f64) -> Value {
     s
 }
 
-/// The cell field `name` of a VTU frame (vtkio).
+/// The cell field `name` of a VTU frame (the reader next to the writer, `vtk::vtu`).
 fn vtu_cell_field(path: &Path, name: &str) -> Vec<f64> {
-    use vtkio::model::{Attribute, DataSet};
-    let vtk = vtkio::Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let DataSet::UnstructuredGrid { pieces, .. } = vtk.data else {
-        panic!("{}: not an unstructured grid", path.display())
-    };
-    let piece = pieces
-        .into_iter()
-        .next()
-        .unwrap()
-        .into_loaded_piece_data(None)
-        .unwrap();
-    for a in piece.data.cell {
-        if let Attribute::DataArray(d) = a {
-            if d.name == name {
-                return d.data.cast_into::<f64>().unwrap();
-            }
-        }
-    }
-    panic!("{}: no cell field {name}", path.display())
+    jointquake::vtk::vtu::read_vtu_f64_array(path, name).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
