@@ -1072,7 +1072,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     let mut t = Table::new(["PGA [g]", "cheapest sufficient level", "wall time [s]", "slip [m]"]);
     for (p, l, w, s) in &cheapest {
         let num = |x: f64| if x.is_finite() { m(x) } else { "–".to_string() };
-        let _ = t.push_row([m(*p), l.clone(), num(*w), num(*s)]);
+        let _ = t.push_row([fmt_sig_short(*p), l.clone(), num(*w), num(*s)]);
     }
     md.push_str(&t.to_markdown());
     if ssr.is_some() {
