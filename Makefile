@@ -105,7 +105,7 @@ study: venv build
 study-report: build
 	$(BIN) study report $(STUDY)
 
-# The wedge study (docs/wedge.md; out/wedge): 41 runs and the strength reduction.
+# The wedge study (docs/wedge.md; out/wedge): 42 runs and the strength reduction.
 wedge:
 	$(MAKE) --no-print-directory study STUDY=pipelines/wedge_study.json
 

@@ -13,8 +13,14 @@
 //! - contact method and layer: the run scene's joints (the first joint; the study's method
 //!   axis sets every joint alike);
 //! - stiffness factor: the run scene's first Young's modulus over the base scene's;
-//! - rigid rock: the run scene fixes a volume that carries no weight (not in
-//!   `loads.gravity.groups`): the rock.
+//! - rock model ([`report::RockModel`]): the rock is the volumes that carry no weight (not in
+//!   `loads.gravity.groups`); "rigid" when the run scene fixes one of them, "massless" when one
+//!   of them is `massless` (condensed, with the weightless massive layer under the joints,
+//!   docs/dam_physics.md), else "elastic";
+//! - joint law ([`report::CohesionLaw`]): the first joint's `keep_cohesion` /
+//!   `softening_slip`; the base scene's law is the headline, any other is a variant;
+//! - stiffness-proportional damping β: the run scene's `damping` (the base scene's β is the
+//!   headline's, any other a variant).
 //!
 //! Conventions: slip is the relative displacement of the wedge and rock nodes at P2 (middle of
 //! the line of intersection) along the line of intersection, positive down it, from its value
@@ -99,7 +105,7 @@ fn two() -> u8 {
 #[serde(deny_unknown_fields)]
 pub struct SsrSpec {
     /// The scene: labels per axis (axes not named take their first value); its base records
-    /// are dropped (gravity only). E.g. `{"mesh": "medium", "rock": "elasticrock"}`.
+    /// are dropped (gravity only). E.g. `{"mesh": "medium", "rock": "rigidrock"}`.
     #[serde(default)]
     pub run: BTreeMap<String, String>,
     /// Initial bracket [F_low, F_high]. Default [1.0, 3.0] (the seed values lie in 1.6–1.9).
@@ -159,8 +165,8 @@ pub struct WedgeParams {
     /// PGA of the speed-against-accuracy chart and the stiffness table [g]. Default 1.0.
     #[serde(default = "one")]
     pub accuracy_pga: f64,
-    /// The rock model of the main runs: "rigid" (default) or "elastic"; the runs with the
-    /// other one are reported apart.
+    /// The rock model of the main runs: "rigid" (default), "massless" or "elastic"; the runs
+    /// with another one are compared with their main-rock twins.
     #[serde(default = "rigid")]
     pub rock: String,
     /// Fraction of the reference slip within which a cheaper level "is enough". Default 0.10.
@@ -200,6 +206,9 @@ pub struct WedgeKind {
 pub struct StudySsr {
     /// Mesh level and its size.
     pub mesh: String,
+    /// The rock model of its scene (none in a result written before it was recorded).
+    #[serde(default)]
+    pub rock: Option<report::RockModel>,
     pub nodes: usize,
     pub elements: usize,
     pub result: crate::study::ssr::SsrResult,
@@ -229,8 +238,13 @@ impl WedgeKind {
         study.axis(&self.params.pga_axis).map(|a| a.values.iter().filter_map(|v| v.variation.pga.map(|p| (p, v.label.as_str()))).collect()).unwrap_or_default()
     }
 
-    pub fn main_rigid_rock(&self) -> bool {
-        self.params.rock == "rigid"
+    /// The rock model of the main runs (`rock`; checked by [`StudyKind::check`]).
+    pub fn main_rock(&self) -> report::RockModel {
+        match self.params.rock.as_str() {
+            "massless" => report::RockModel::Massless,
+            "elastic" => report::RockModel::Elastic,
+            _ => report::RockModel::Rigid,
+        }
     }
 }
 
@@ -254,8 +268,8 @@ impl StudyKind for WedgeKind {
         if !(1..=2).contains(&p.reference.layer) {
             return Err(invalid(format!("`reference.layer` = {} must be 1 or 2", p.reference.layer)));
         }
-        if !matches!(p.rock.as_str(), "rigid" | "elastic") {
-            return Err(invalid(format!("`rock` = \"{}\" must be \"rigid\" or \"elastic\"", p.rock)));
+        if !matches!(p.rock.as_str(), "rigid" | "massless" | "elastic") {
+            return Err(invalid(format!("`rock` = \"{}\" must be \"rigid\", \"massless\" or \"elastic\"", p.rock)));
         }
         if !(p.enough > 0.0 && p.enough < 1.0) {
             return Err(invalid(format!("`enough` = {} must be a fraction in (0, 1)", p.enough)));
@@ -350,6 +364,6 @@ impl WedgeKind {
         if !le_fs.is_finite() {
             return Err(ModelError::Invalid("limit equilibrium of the study's wedge gave no finite FS".into()).into());
         }
-        Ok(StudySsr { mesh: level, nodes, elements, result, le_fs, le_fs_crest_on_a, wall_time: t0.elapsed().as_secs_f64() })
+        Ok(StudySsr { mesh: level, rock: Some(report::rock_model(&scene)), nodes, elements, result, le_fs, le_fs_crest_on_a, wall_time: t0.elapsed().as_secs_f64() })
     }
 }

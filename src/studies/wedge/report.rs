@@ -70,6 +70,64 @@ fn joint_counts(h: &HistoryTable) -> Result<JointCounts, OutputError> {
     })
 }
 
+/// The rock model of a run (see the module doc of [`super`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RockModel {
+    /// The rock's nodes fixed: the wedge feels the base motion itself.
+    Rigid,
+    /// The rock elastic and massless (condensed statically, docs/dam_physics.md §1), with the
+    /// weightless massive layer of elements along the joint faces.
+    Massless,
+    /// The rock elastic with its mass (a closed box without absorbing boundaries).
+    Elastic,
+}
+
+impl RockModel {
+    pub fn describe(self) -> &'static str {
+        match self {
+            RockModel::Rigid => "rigid rock",
+            RockModel::Massless => "massless elastic rock",
+            RockModel::Elastic => "elastic rock with mass",
+        }
+    }
+}
+
+/// The cohesion law of a run's joints (its first joint; the study sets every joint alike).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CohesionLaw {
+    /// Mohr-Coulomb with the cohesion kept after slip and opening (the seed's law).
+    Kept,
+    /// Cohesion softening linearly to zero over `slip` [m] of a pair's accumulated slip.
+    Softening { slip: f64 },
+    /// Cohesion lost at a pair's first slip or opening.
+    Brittle,
+}
+
+impl CohesionLaw {
+    fn of(j: &crate::scene::JointSceneSpec) -> CohesionLaw {
+        match (j.keep_cohesion, j.softening_slip) {
+            (Some(true), _) => CohesionLaw::Kept,
+            (_, Some(d)) if d > 0.0 => CohesionLaw::Softening { slip: d },
+            _ => CohesionLaw::Brittle,
+        }
+    }
+
+    pub fn describe(self) -> String {
+        match self {
+            CohesionLaw::Kept => "cohesion kept (Mohr-Coulomb, no softening: the seed's law)".into(),
+            CohesionLaw::Softening { slip } => format!("cohesion lost after slip (softening to zero over {} mm)", fmt_sig_short(slip * 1e3)),
+            CohesionLaw::Brittle => "cohesion lost at the first slip (brittle)".into(),
+        }
+    }
+
+    /// The rigid block's bond for this law: kept, or lost at the first slide.
+    pub fn bond(self) -> Bond {
+        if self == CohesionLaw::Kept { Bond::Kept } else { Bond::Brittle }
+    }
+}
+
 /// What a FEM run of the wedge study is, read from its scene and its labels (see the module
 /// doc of [`super`]).
 #[derive(Clone, Debug, Serialize)]
@@ -84,8 +142,12 @@ pub struct WedgeRunSpec {
     pub pga: f64,
     /// Factor on the Young's modulus (run scene over base scene).
     pub e_factor: f64,
-    /// Rock nodes fixed (FEM wedge on a rigid rock).
-    pub rigid_rock: bool,
+    /// The rock model.
+    pub rock: RockModel,
+    /// The joints' cohesion law.
+    pub law: CohesionLaw,
+    /// Stiffness-proportional Rayleigh coefficient β of the run [s].
+    pub beta: f64,
 }
 
 impl WedgeRunSpec {
@@ -102,8 +164,6 @@ impl WedgeRunSpec {
         let j = scene.joints.first().ok_or("its scene has no joints")?;
         let e0 = base.materials.first().map(|m| m.e).ok_or("the base scene has no material")?;
         let e = scene.materials.first().map(|m| m.e).ok_or("its scene has no material")?;
-        let weighted = scene.loads.gravity.as_ref().and_then(|g| g.groups.clone()).unwrap_or_default();
-        let rock: Vec<&str> = scene.materials.iter().filter(|m| !weighted.contains(&m.group)).map(|m| m.group.as_str()).collect();
         Ok(WedgeRunSpec {
             id: run.spec.id.clone(),
             mesh,
@@ -111,9 +171,30 @@ impl WedgeRunSpec {
             layer: j.layer.unwrap_or(1),
             pga,
             e_factor: e / e0,
-            rigid_rock: scene.boundary.iter().any(|b| rock.contains(&b.group.as_str())),
+            rock: rock_model(scene),
+            law: CohesionLaw::of(j),
+            beta: stiffness_damping(scene),
         })
     }
+}
+
+/// The rock model of `scene`: its rock is the volumes outside `loads.gravity.groups`.
+pub fn rock_model(scene: &Scene) -> RockModel {
+    let weighted = scene.loads.gravity.as_ref().and_then(|g| g.groups.clone()).unwrap_or_default();
+    let rock: Vec<&crate::scene::MaterialSpec> = scene.materials.iter().filter(|m| !weighted.contains(&m.group)).collect();
+    if scene.boundary.iter().any(|b| rock.iter().any(|m| m.group == b.group)) {
+        RockModel::Rigid
+    } else if rock.iter().any(|m| m.massless) {
+        RockModel::Massless
+    } else {
+        RockModel::Elastic
+    }
+}
+
+/// The stiffness-proportional damping coefficient β [s] of `scene` (0 when its damping is
+/// invalid: the scene was validated when it was planned).
+fn stiffness_damping(scene: &Scene) -> f64 {
+    scene.damping.coefficients().map(|c| c.1).unwrap_or(0.0)
 }
 
 /// The outcome of one FEM run, as the report uses it.
@@ -144,8 +225,11 @@ pub struct WedgeRun {
     /// motion the rock delivers under the wedge, to compare with the PGA.
     pub rock_peak_accel: Option<[f64; 3]>,
     /// Residual slip of the rigid block driven by the rock monitor's computed absolute motion
-    /// (cohesion lost at first slide) [m]: the rigid level with the FEM's site response.
+    /// (with the run's bond: kept, or lost at the first slide) [m]: the rigid level with the
+    /// FEM's site response.
     pub rigid_on_rock_slip: Option<f64>,
+    /// First time at which the slip exceeds 1 mm [s] (none if it never does).
+    pub onset: Option<f64>,
     /// Slip history (t, slip) sampled for charts (at most about 2000 points).
     #[serde(skip)]
     pub slip_history: Vec<(f64, f64)>,
@@ -273,7 +357,7 @@ fn read_run(kind: &WedgeKind, res: &RunResult, base: &Scene, e: [f64; 3], line_l
         if rh.t.len() > 2 {
             let dt = rh.t[1] - rh.t[0];
             // a wedge that the rock's motion lifts off its planes has no rigid-block answer
-            if let Ok(r) = rigid_wedge_slip(&kind.wedge_of(scene), &abs, dt, Bond::Brittle, false) {
+            if let Ok(r) = rigid_wedge_slip(&kind.wedge_of(scene), &abs, dt, spec.law.bond(), false) {
                 rigid_on_rock_slip = Some(r.result.residual_displacement);
             }
         }
@@ -298,6 +382,7 @@ fn read_run(kind: &WedgeKind, res: &RunResult, base: &Scene, e: [f64; 3], line_l
         lost_node_steps: lost,
         rock_peak_accel,
         rigid_on_rock_slip,
+        onset: slip.iter().find(|x| x.1 > 1e-3).map(|x| x.0),
         slip_history: thin(&slip, 2000),
         p1_history: thin(&p1_h, 2000),
     })
@@ -311,6 +396,21 @@ pub struct RigidAtPga {
     pub kept: RigidWedgeRun,
     /// Compute time of the brittle run [s] (for the speed-against-accuracy chart).
     pub wall_time: f64,
+}
+
+impl RigidAtPga {
+    /// The rigid block with `bond`.
+    pub fn of_bond(&self, bond: Bond) -> &RigidWedgeRun {
+        match bond {
+            Bond::Kept => &self.kept,
+            Bond::Brittle => &self.brittle,
+        }
+    }
+
+    /// The rigid block that goes with the joints' `law` (kept, or lost at the first slide).
+    pub fn bond(&self, law: CohesionLaw) -> &RigidWedgeRun {
+        self.of_bond(law.bond())
+    }
 }
 
 /// The rigid level at one PGA: the scene of the study at that PGA (the other axes at their
@@ -341,6 +441,11 @@ pub struct WedgeReport {
     /// For each PGA: the cheapest level within `enough` of the reference slip.
     pub cheapest: Vec<(f64, String, f64, f64)>,
     pub trend: Vec<String>,
+    /// The seed's claims against the headline runs.
+    pub claims: Vec<SeedClaim>,
+    /// The headline's joint law and stiffness-proportional damping β [s] (the base scene's).
+    pub headline_law: CohesionLaw,
+    pub headline_beta: f64,
 }
 
 /// Limit-equilibrium numbers of the report.
@@ -358,8 +463,10 @@ fn find(runs: &[WedgeRun], pred: impl Fn(&WedgeRunSpec) -> bool) -> Option<&Wedg
     runs.iter().find(|r| pred(&r.spec))
 }
 
+/// A number with 4 significant digits; values below 1e-12 in magnitude (round-off of a
+/// slip that did not happen) print as 0.
 fn m(x: f64) -> String {
-    fmt_sig(x, 4)
+    if x.abs() < 1e-12 { "0".into() } else { fmt_sig(x, 4) }
 }
 
 /// A number in its shortest form with at most 4 significant digits (20 → "20", 24.5 → "24.5").
@@ -370,6 +477,42 @@ fn fmt_sig_short(x: f64) -> String {
 
 fn opt(x: Option<f64>) -> String {
     x.map_or_else(|| "–".to_string(), m)
+}
+
+/// The seed's quoted results (seed paper, section 4, Koyna record): residual slip at P2 at
+/// 1.0 g [m], NTS and NTN; P1 residual displacement at 1.0 g [m] (x, y, z); the time at which
+/// the wedge starts to slide at 1.0 g [s]; the PGA at and below which it does not slide
+/// noticeably [g]; its strength-reduction factor and the DDA and FEM factors it quotes.
+pub mod seed {
+    pub const SLIP_NTS_1G: f64 = 0.186;
+    pub const SLIP_NTN_1G: f64 = 0.147;
+    pub const P1_NTS_1G: [f64; 3] = [0.072, -0.143, -0.102];
+    pub const P1_NTN_1G: [f64; 3] = [0.056, -0.113, -0.082];
+    pub const ONSET_1G: f64 = 2.4;
+    pub const NO_SLIDING_UP_TO: f64 = 0.5;
+    pub const PGA: f64 = 1.0;
+}
+
+/// One of the seed's claims and what our runs give.
+#[derive(Clone, Debug, Serialize)]
+pub struct SeedClaim {
+    pub claim: String,
+    pub seed: String,
+    pub ours: String,
+    /// Reproduced (true), not (false), or not decidable from the runs (none).
+    pub reproduced: Option<bool>,
+}
+
+/// Angle between two vectors [deg].
+fn angle_deg(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let na = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    let nb = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+    (dot / (na * nb)).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+fn cm3(u: [f64; 3]) -> String {
+    format!("({}, {}, {}) cm", fmt_sig(u[0] * 100.0, 3), fmt_sig(u[1] * 100.0, 3), fmt_sig(u[2] * 100.0, 3))
 }
 
 /// The wedge study's part of the report (`report.md`, the `report` of `report.json`, the
@@ -426,62 +569,95 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     let sweep = prm.sweep_mesh.clone();
     let reference = prm.reference.mesh.clone();
     let rigid_of = |pga: f64| rigid.iter().find(|r| r.pga == pga).expect("rigid level of every PGA");
-    let rr = kind.main_rigid_rock();
-    let (main_rock, other_rock) = if rr { ("rigid rock", "elastic rock") } else { ("elastic rock", "rigid rock") };
-    let is_ref = |s: &WedgeRunSpec| s.mesh == reference && s.method == "nts" && s.layer == prm.reference.layer && s.e_factor == 1.0 && s.rigid_rock == rr;
-    let plain = |s: &WedgeRunSpec| s.e_factor == 1.0 && s.rigid_rock == rr;
+    // the headline: the base scene's law, damping and stiffness on the main rock
+    let main_rock = kind.main_rock();
+    let main_law = base.joints.first().map(CohesionLaw::of).unwrap_or(CohesionLaw::Brittle);
+    let main_beta = stiffness_damping(base);
+    let rigid_main = |p: f64| rigid_of(p).bond(main_law).result.residual_displacement;
+    let plain = |s: &WedgeRunSpec| s.e_factor == 1.0 && s.rock == main_rock && s.law == main_law && s.beta == main_beta;
+    let is_ref = |s: &WedgeRunSpec| plain(s) && s.mesh == reference && s.method == "nts" && s.layer == prm.reference.layer;
+    let run_of = |pred: &dyn Fn(&WedgeRunSpec) -> bool| find(&runs, pred).filter(|r| r.failed.is_none());
+    // the variant law (the first law of the runs that is not the headline's), if any
+    let other_law = runs.iter().map(|r| r.spec.law).find(|l| *l != main_law);
+    let acc = prm.accuracy_pga;
 
-    // ---- chart: slip against PGA (finished runs only; a failed run is listed in the tables)
-    let pts = |method: &str, mesh: &str, layer: u8, rigid_rock: bool| -> Vec<(f64, f64)> {
-        pgas
-            .iter()
-            .filter_map(|&p| {
-                find(&runs, |s| s.e_factor == 1.0 && s.rigid_rock == rigid_rock && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer)
-                    .filter(|r| r.failed.is_none())
-                    .map(|r| (p, r.residual_slip.abs()))
-            })
+    // ---- slip against PGA: the headline, the seed's values
+    let pts = |method: &str, mesh: &str, layer: u8, sel: &dyn Fn(&WedgeRunSpec) -> bool| -> Vec<(f64, f64)> {
+        pgas.iter()
+            .filter_map(|&p| run_of(&|s| sel(s) && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer).map(|r| (p, r.residual_slip.abs())))
             .collect()
     };
-    let nts_sweep = pts("nts", &sweep, 1, rr);
-    let ntn_sweep = pts("ntn", &sweep, 1, rr);
-    let nts_other = pts("nts", &sweep, 1, !rr);
-    let ntn_other = pts("ntn", &sweep, 1, !rr);
-    let reference_pts = pts("nts", &reference, prm.reference.layer, rr);
-    let mut c = Chart::new(format!("Residual slip at P2 against PGA ({})", base.name()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {main_rock}"), nts_sweep.clone()));
-    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, {main_rock}"), ntn_sweep.clone()));
-    if reference != sweep {
-        c.series.push(Series::line_markers(format!("NTS-L{}, {reference} mesh, {main_rock} (reference)", prm.reference.layer), reference_pts.clone()));
+    let nts_sweep = pts("nts", &sweep, 1, &plain);
+    let ntn_sweep = pts("ntn", &sweep, 1, &plain);
+    let nts2_sweep = pts("nts", &sweep, 2, &plain);
+    let reference_pts = pts("nts", &reference, prm.reference.layer, &plain);
+    let rigid_kept_pts: Vec<(f64, f64)> = pgas.iter().map(|&p| (p, rigid_main(p))).collect();
+    let mut c = Chart::new(format!("Residual slip at P2 against PGA — {}", main_law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), nts_sweep.clone()));
+    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), ntn_sweep.clone()));
+    if !nts2_sweep.is_empty() {
+        c.series.push(Series::line_markers(format!("NTS-L2, {sweep} mesh"), nts2_sweep.clone()));
     }
-    let rigid_lost: Vec<(f64, f64)> = pgas.iter().map(|&p| (p, rigid_of(p).brittle.result.residual_displacement)).collect();
-    let rigid_kept: Vec<(f64, f64)> = pgas.iter().map(|&p| (p, rigid_of(p).kept.result.residual_displacement)).collect();
-    c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", rigid_lost.clone()));
-    c.series.push(Series::line_markers("rigid block, cohesion kept", rigid_kept.clone()));
+    if reference != sweep && !reference_pts.is_empty() {
+        c.series.push(Series::markers(format!("NTS-L{}, {reference} mesh (reference)", prm.reference.layer), reference_pts.clone()));
+    }
+    c.series.push(Series::line_markers(format!("rigid block, {}", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), rigid_kept_pts.clone()));
+    c.series.push(Series::markers("seed NTS (Koyna record)", [(seed::PGA, seed::SLIP_NTS_1G)]));
+    c.series.push(Series::markers("seed NTN (Koyna record)", [(seed::PGA, seed::SLIP_NTN_1G)]));
     charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga"))?.png);
-    if !nts_other.is_empty() {
-        // the other rock model on its own chart: its slips can be an order of magnitude apart
-        let mut c = Chart::new(format!("Residual slip at P2 against PGA: {other_rock} and {main_rock}"), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {other_rock}"), nts_other.clone()));
-        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh, {other_rock}"), ntn_other.clone()));
-        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {main_rock}"), nts_sweep.clone()));
-        c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", rigid_lost));
-        charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga_other_rock"))?.png);
+
+    // ---- the variant law
+    let variant = |s: &WedgeRunSpec| Some(s.law) == other_law && s.e_factor == 1.0 && s.rock == main_rock && s.beta == main_beta;
+    let nts_var = pts("nts", &sweep, 1, &variant);
+    let ntn_var = pts("ntn", &sweep, 1, &variant);
+    if let Some(law) = other_law.filter(|_| !nts_var.is_empty() || !ntn_var.is_empty()) {
+        let mut c = Chart::new(format!("Residual slip at P2 against PGA — variant: {}", law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), nts_var.clone()));
+        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), ntn_var.clone()));
+        c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", pgas.iter().map(|&p| (p, rigid_of(p).bond(law).result.residual_displacement))));
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {} (headline)", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "headline law" }), nts_sweep.clone()));
+        charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga_variant"))?.png);
+    }
+
+    // ---- other rock models: each run against its main-rock twin
+    let twin_of = |r: &WedgeRun| {
+        run_of(&|s: &WedgeRunSpec| s.rock == main_rock && s.pga == r.spec.pga && s.method == r.spec.method && s.layer == r.spec.layer && s.mesh == r.spec.mesh && s.law == r.spec.law && s.e_factor == r.spec.e_factor && s.beta == r.spec.beta)
+    };
+    let other_rock: Vec<&WedgeRun> = runs.iter().filter(|r| r.spec.rock != main_rock).collect();
+    if !other_rock.is_empty() {
+        let mut c = Chart::new("Residual slip at P2 against PGA: rock models", "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+        let mut keys: Vec<(String, String, u8, RockModel)> = Vec::new();
+        for r in &other_rock {
+            let k = (r.spec.method.clone(), r.spec.mesh.clone(), r.spec.layer, r.spec.rock);
+            if !keys.contains(&k) {
+                keys.push(k);
+            }
+        }
+        for (method, mesh, layer, rock) in keys {
+            let same = |s: &WedgeRunSpec, rk: RockModel| s.rock == rk && s.law == main_law && s.beta == main_beta && s.e_factor == 1.0;
+            let name = if method == "nts" { format!("NTS-L{layer}") } else { method.to_uppercase() };
+            c.series.push(Series::line_markers(format!("{name}, {mesh} mesh, {}", rock.describe()), pts(&method, &mesh, layer, &|s| same(s, rock))));
+            c.series.push(Series::line_markers(format!("{name}, {mesh} mesh, {}", main_rock.describe()), pts(&method, &mesh, layer, &|s| same(s, main_rock))));
+        }
+        charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga_rock"))?.png);
     }
 
     // ---- chart: slip history at the accuracy PGA
-    let acc = prm.accuracy_pga;
-    let nts_acc = find(&runs, |s| plain(s) && s.pga == acc && s.method == "nts" && s.mesh == sweep && s.layer == 1);
-    let ntn_acc = find(&runs, |s| plain(s) && s.pga == acc && s.method == "ntn" && s.mesh == sweep);
-    let ref_acc = find(&runs, |s| is_ref(s) && s.pga == acc);
-    let mut c = Chart::new(format!("Slip history at P2, PGA {acc} g"), "t [s]", "slip along the line of intersection [m]");
+    let nts_acc = run_of(&|s| plain(s) && s.pga == acc && s.method == "nts" && s.mesh == sweep && s.layer == 1);
+    let ntn_acc = run_of(&|s| plain(s) && s.pga == acc && s.method == "ntn" && s.mesh == sweep);
+    let ref_acc = run_of(&|s| is_ref(s) && s.pga == acc);
+    let mut c = Chart::new(format!("Slip history at P2, PGA {acc} g — {}", main_law.describe()), "t [s]", "slip along the line of intersection [m]");
     for (r, name) in [(nts_acc, format!("NTS-L1, {sweep}")), (ntn_acc, format!("NTN, {sweep}")), (ref_acc, format!("reference NTS-L{}, {reference}", prm.reference.layer))] {
         if let Some(r) = r {
             c.series.push(Series::line(name, r.slip_history.clone()));
         }
     }
     let ra = rigid_of(acc);
-    if let Some(h) = &ra.brittle.result.history {
-        c.series.push(Series::line("rigid block (cohesion lost)", sampled_history(h, ra.brittle.dt)));
+    for (bond, name) in [(Bond::Kept, "rigid block, cohesion kept"), (Bond::Brittle, "rigid block, cohesion lost at first slide")] {
+        let rb = ra.of_bond(bond);
+        if let Some(h) = &rb.result.history {
+            c.series.push(Series::line(name, sampled_history(h, rb.dt)));
+        }
     }
     charts.push(c.write_png_svg(&charts_dir.join("slip_history"))?.png);
 
@@ -496,10 +672,11 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     }
     charts.push(c.write_png_svg(&charts_dir.join("p1_history"))?.png);
 
-    // ---- speed against accuracy at the accuracy PGA
+    // ---- speed against accuracy at the accuracy PGA (headline runs)
     let ref_slip = ref_acc.map(|r| r.residual_slip).unwrap_or(f64::NAN);
+    let rigid_acc = ra.bond(main_law);
     let mut sa: Vec<(String, f64, f64, f64)> = Vec::new(); // (level, wall, slip, error)
-    sa.push(("rigid block".into(), ra.wall_time.max(1e-4), ra.brittle.result.residual_displacement, (ra.brittle.result.residual_displacement - ref_slip).abs() / ref_slip.abs()));
+    sa.push(("rigid block".into(), ra.wall_time.max(1e-4), rigid_acc.result.residual_displacement, (rigid_acc.result.residual_displacement - ref_slip).abs() / ref_slip.abs()));
     for r in runs.iter().filter(|r| plain(&r.spec) && r.spec.pga == acc && !is_ref(&r.spec) && r.failed.is_none()) {
         let Some(wall) = r.wall_time else { continue };
         sa.push((r.level.clone(), wall, r.residual_slip, (r.residual_slip - ref_slip).abs() / ref_slip.abs()));
@@ -523,7 +700,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         charts.push(c.write_png_svg(&charts_dir.join("ssr"))?.png);
     }
 
-    // ---- cheapest level per PGA
+    // ---- cheapest level per PGA (where the reference ran)
     let mut cheapest = Vec::new();
     for &p in &pgas {
         let Some(r) = find(&runs, |s| is_ref(s) && s.pga == p) else { continue };
@@ -533,7 +710,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         }
         let refv = r.residual_slip;
         let rg = rigid_of(p);
-        let mut cands: Vec<(String, f64, f64)> = vec![("rigid block".into(), rg.wall_time, rg.brittle.result.residual_displacement)];
+        let mut cands: Vec<(String, f64, f64)> = vec![("rigid block".into(), rg.wall_time, rg.bond(main_law).result.residual_displacement)];
         for x in runs.iter().filter(|x| plain(&x.spec) && x.spec.pga == p && !is_ref(&x.spec) && x.failed.is_none()) {
             if let Some(wall) = x.wall_time {
                 cands.push((x.level.clone(), wall, x.residual_slip));
@@ -549,40 +726,95 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         }
     }
 
-    // ---- trend against the seed, for each rock model
+    // ---- trend of NTS against NTN, for the headline and the variant
     let mut trend = Vec::new();
-    for (label, nts, ntn) in [(main_rock, &nts_sweep, &ntn_sweep), (other_rock, &nts_other, &ntn_other)] {
-        let pairs: Vec<(f64, f64, f64)> = pgas
+    let variant_label = other_law.map(|l| format!("variant ({})", l.describe()));
+    for (label, nts, ntn) in [(Some(format!("headline ({})", main_law.describe())), &nts_sweep, &ntn_sweep), (variant_label, &nts_var, &ntn_var)] {
+        let Some(label) = label else { continue };
+        trend.extend(nts_ntn_trend(&label, &pgas, nts, ntn));
+    }
+
+    // ---- the seed's claims against the headline runs
+    let mut claims = Vec::new();
+    {
+        let low: Vec<(f64, f64)> = pgas
             .iter()
+            .filter(|&&p| p <= seed::NO_SLIDING_UP_TO)
             .filter_map(|&p| {
-                let a = nts.iter().find(|x| x.0 == p)?.1;
-                let b = ntn.iter().find(|x| x.0 == p)?.1;
-                Some((p, a, b))
+                let a = nts_sweep.iter().chain(&ntn_sweep).filter(|x| x.0 == p).map(|x| x.1).fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))?;
+                Some((p, a))
             })
             .collect();
-        if pairs.is_empty() {
-            continue;
+        if !low.is_empty() {
+            let ok = low.iter().all(|x| x.1 < 0.01);
+            claims.push(SeedClaim {
+                claim: format!("no obvious sliding at {} g and below", seed::NO_SLIDING_UP_TO),
+                seed: "stated (figure 11)".into(),
+                ours: low.iter().map(|(p, s)| format!("largest NTS/NTN slip {} m at {p} g", m(*s))).collect::<Vec<_>>().join("; "),
+                reproduced: Some(ok),
+            });
         }
-        let sliding: Vec<&(f64, f64, f64)> = pairs.iter().filter(|x| x.1.max(x.2) >= 0.01).collect();
-        let above = sliding.iter().filter(|x| x.1 >= x.2).count();
-        trend.push(format!("{label}: NTS ≥ NTN at {above} of the {} PGAs with slip ≥ 1 cm (seed: NTS above NTN at every PGA that slides).", sliding.len()));
-        let diffs: Vec<(f64, f64)> = sliding.iter().map(|x| (x.0, (x.1 - x.2) / x.2.max(1e-12))).collect();
-        if !diffs.is_empty() {
-            let growing = diffs.windows(2).all(|w| w[1].1 >= w[0].1);
-            trend.push(format!(
-                "{label}: (NTS − NTN)/NTN by PGA: {} — {} (seed: the difference grows with PGA).",
-                diffs.iter().map(|(p, d)| format!("{p} g: {}", fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
-                if growing { "grows with PGA" } else { "does not grow monotonically with PGA" }
-            ));
+        let at = |v: &[(f64, f64)]| v.iter().find(|x| x.0 == seed::PGA).map(|x| x.1);
+        if let (Some(a), Some(b)) = (at(&nts_sweep), at(&ntn_sweep)) {
+            claims.push(SeedClaim {
+                claim: format!("residual slip at {} g, NTS / NTN", seed::PGA),
+                seed: format!("{} / {} m", seed::SLIP_NTS_1G, seed::SLIP_NTN_1G),
+                ours: format!("{} / {} m ({} / {} of the seed's)", m(a), m(b), fmt_sig(a / seed::SLIP_NTS_1G, 3), fmt_sig(b / seed::SLIP_NTN_1G, 3)),
+                reproduced: Some((a / seed::SLIP_NTS_1G - 1.0).abs() <= 0.5 && (b / seed::SLIP_NTN_1G - 1.0).abs() <= 0.5),
+            });
+            let d = (a - b) / b;
+            let ds = (seed::SLIP_NTS_1G - seed::SLIP_NTN_1G) / seed::SLIP_NTN_1G;
+            claims.push(SeedClaim {
+                claim: format!("NTS slides more than NTN at {} g", seed::PGA),
+                seed: fmt_percent(ds, 1),
+                ours: fmt_percent(d, 1),
+                reproduced: Some(d > 0.0),
+            });
         }
-        if let Some(d) = diffs.iter().find(|x| x.0 == 1.0) {
-            trend.push(format!("{label}: at 1.0 g (NTS − NTN)/NTN = {} (seed: +26.5 % with the Koyna record, 18.6 cm vs 14.7 cm).", fmt_percent(d.1, 1)));
+        let sliding: Vec<(f64, f64, f64)> = pgas
+            .iter()
+            .filter_map(|&p| {
+                let a = nts_sweep.iter().find(|x| x.0 == p)?.1;
+                let b = ntn_sweep.iter().find(|x| x.0 == p)?.1;
+                Some((p, a, b))
+            })
+            .filter(|x| x.1.max(x.2) >= 0.01)
+            .collect();
+        if sliding.len() >= 2 {
+            let diffs: Vec<f64> = sliding.iter().map(|x| (x.1 - x.2) / x.2.max(1e-12)).collect();
+            claims.push(SeedClaim {
+                claim: "NTS above NTN at every PGA that slides, the difference growing with PGA".into(),
+                seed: "stated (figure 11)".into(),
+                ours: sliding.iter().zip(&diffs).map(|(x, d)| format!("{} g {}", x.0, fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
+                reproduced: Some(diffs.iter().all(|&d| d > 0.0) && diffs.windows(2).all(|w| w[1] >= w[0])),
+            });
         }
-        let none_below: Vec<f64> = pairs.iter().filter(|x| x.1.max(x.2) < 0.01).map(|x| x.0).collect();
-        trend.push(format!(
-            "{label}: no significant sliding (< 1 cm) at {} (seed: none at 0.5 g and below).",
-            if none_below.is_empty() { "no PGA".to_string() } else { none_below.iter().map(|p| format!("{p} g")).collect::<Vec<_>>().join(", ") }
-        ));
+        for (r, tag, s) in [(nts_acc, "NTS", seed::P1_NTS_1G), (ntn_acc, "NTN", seed::P1_NTN_1G)] {
+            if let Some(r) = r.filter(|_| acc == seed::PGA) {
+                let ang = angle_deg(r.p1_residual, s);
+                let ratio = (r.p1_residual.iter().map(|x| x * x).sum::<f64>() / s.iter().map(|x| x * x).sum::<f64>()).sqrt();
+                claims.push(SeedClaim {
+                    claim: format!("P1 residual displacement at {} g, {tag}", seed::PGA),
+                    seed: cm3(s),
+                    ours: format!("{}: {}° from the seed's direction, {} × its length", cm3(r.p1_residual), fmt_sig(ang, 2), fmt_sig(ratio, 3)),
+                    reproduced: Some(ang <= 15.0 && (ratio - 1.0).abs() <= 0.5),
+                });
+            }
+        }
+        if let Some(r) = nts_acc.filter(|_| acc == seed::PGA) {
+            claims.push(SeedClaim {
+                claim: format!("the wedge starts to slide at about {} s and is at rest when the shaking ends ({} g)", seed::ONSET_1G, seed::PGA),
+                seed: format!("{} s; at rest", seed::ONSET_1G),
+                ours: format!("slip exceeds 1 mm at {} s (NTS); {}", r.onset.map(|t| fmt_sig(t, 3)).unwrap_or_else(|| "never".into()), if r.still_sliding { "still sliding at the end" } else { "at rest at the end" }),
+                reproduced: None,
+            });
+            claims.push(SeedClaim {
+                claim: "failure mode: sliding along the line of intersection on both planes, the same for NTS and NTN".into(),
+                seed: "stated (figure 8)".into(),
+                ours: format!("NTS: {}; NTN: {}", r.mode, ntn_acc.map(|x| x.mode.as_str()).unwrap_or("–")),
+                reproduced: Some(r.mode.starts_with("sliding on both planes") && ntn_acc.is_none_or(|x| x.mode.starts_with("sliding on both planes"))),
+            });
+        }
     }
 
     // ---- report.md
@@ -612,12 +844,6 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         }
     );
     let _ = writeln!(md, "- Materials: {mat}. The seed gives no elastic constants; these are chosen (a moderately jointed rock mass) and the sensitivity to E is below.");
-    let dc = base.joints.iter().filter_map(|j| j.softening_slip).fold(0.0, f64::max);
-    let loss = if dc > 0.0 {
-        format!("Cohesion is lost after slip: it softens linearly to zero over d_c = {} mm of a pair's accumulated slip (and an opening beyond d_c breaks it)", dc * 1e3)
-    } else {
-        "Cohesion is lost at a pair's first slip or opening (brittle)".to_string()
-    };
     let strength = base
         .joints
         .iter()
@@ -632,13 +858,21 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         })
         .collect::<Vec<_>>()
         .join("; ");
-    let _ = writeln!(md, "- Joints: {strength} (seed table 1). {loss}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).");
+    let _ = writeln!(md, "- Joints: {strength} (seed table 1). Headline: {}{}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).", main_law.describe(), other_law.map(|l| format!("; variant: {}", l.describe())).unwrap_or_default());
     let grav = base.loads.gravity.as_ref().and_then(|g| g.groups.clone()).map(|g| g.join(", ")).unwrap_or_else(|| "all".into());
     let _ = writeln!(md, "- Gravity on: {grav} (the rock is a weightless support, as in limit equilibrium); brought to equilibrium before the record.");
+    let others: Vec<RockModel> = other_rock.iter().fold(Vec::new(), |mut v, r| {
+        if !v.contains(&r.spec.rock) {
+            v.push(r.spec.rock);
+        }
+        v
+    });
     let _ = writeln!(
         md,
-        "- Rock of the main runs: {main_rock}{}. The PGA sweep is repeated with the {other_rock} (tables and the slip-against-PGA chart).",
-        if rr { " (its nodes fixed: the wedge slides on its joints under the base motion itself, as on a stiff massless foundation; the elastic rock box, without absorbing boundaries, rings: see \"The rock's response\")" } else { "" }
+        "- Rock of the main runs: {}{}.{}",
+        main_rock.describe(),
+        if main_rock == RockModel::Rigid { " (its nodes fixed: the wedge slides on its joints under the base motion itself)" } else { "" },
+        if others.is_empty() { String::new() } else { format!(" Compared with: {} (section \"Rock model\").", others.iter().map(|r| r.describe()).collect::<Vec<_>>().join(", ")) }
     );
     let recs = base.loads.base.iter().map(|b| format!("`{}` along ({}, {}, {}) × {}", b.record.as_ref().and_then(|r| r.file_name()).map(|f| f.to_string_lossy().into_owned()).unwrap_or_else(|| b.synth.as_ref().map(|s| format!("synth seed {} {}", s.seed, s.component)).unwrap_or_default()), b.direction[0], b.direction[1], b.direction[2], b.pga.map(|p| format!("PGA {p} g")).or(b.scale.map(|s| format!("scale {s}"))).unwrap_or_else(|| "1".into()))).collect::<Vec<_>>().join("; ");
     let _ = writeln!(md, "- Base motion (base scene): {recs}. Every record is scaled by one factor so that the horizontal PGA takes the study values: by default the committed El Centro 1940 NS record horizontally (y, north) and 2/3 of the same record vertically (z), in phase. The seed used the Koyna record, which is not public.");
@@ -660,9 +894,10 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         let dev = s.result.factor / le.fs_intersection - 1.0;
         let _ = writeln!(
             md,
-            "\nFEM against limit equilibrium for the same geometry: {} ({}). Failure criterion: {}. The seed's 1.66 and 1.68 match our limit equilibrium with H read as the crest height on plane A ({}); its own 1.60 is below both readings.\n",
+            "\nFEM against limit equilibrium for the same geometry: {} ({}). Rock of the strength reduction: {} (`ssr.run`). Failure criterion: {}. The seed's 1.66 and 1.68 match our limit equilibrium with H read as the crest height on plane A ({}); its own 1.60 is below both readings.\n",
             fmt_percent(dev, 1),
             if dev.abs() <= 0.03 { "within the 3 % required" } else { "outside 3 %" },
+            s.rock.map(|r| r.describe()).unwrap_or("not recorded"),
             s.result.criterion,
             m(le.fs_crest_on_a)
         );
@@ -674,24 +909,175 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         le.kc_residual.map(m).unwrap_or_else(|| "none".into())
     );
 
-    let _ = writeln!(md, "## Seismic runs\n");
-    let joint_names = base.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(" / ");
-    let mut t = Table::new(["PGA [g]".to_string(), "level".into(), "P1 ux".into(), "P1 uy".into(), "P1 uz".into(), "slip at P2".into(), "still sliding".into(), "failure mode".into(), format!("max opening {joint_names}")]);
+    // ---- 1. the headline
+    let _ = writeln!(md, "## Seismic runs — headline: {}\n", main_law.describe());
+    let _ = writeln!(md, "{}, β = {} s, E as given; residual slip at P2 [m]. The seed's values are from its figures 10–11 and text (Koyna record).\n", main_rock.describe(), fmt_sig(main_beta, 3));
+    let has_nts2 = !nts2_sweep.is_empty();
+    let has_ref = reference != sweep && !reference_pts.is_empty();
+    let mut head = vec![format!("PGA [g]"), format!("NTS-L1 {sweep}"), format!("NTN {sweep}")];
+    if has_nts2 {
+        head.push(format!("NTS-L2 {sweep}"));
+    }
+    if has_ref {
+        head.push(format!("NTS-L{} {reference}", prm.reference.layer));
+    }
+    head.extend([format!("rigid block ({})", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost" }), "(NTS − NTN)/NTN".into(), "seed NTS / NTN".into()]);
+    let mut t = Table::new(head);
+    let val = |v: &[(f64, f64)], p: f64| v.iter().find(|x| x.0 == p).map(|x| m(x.1)).unwrap_or_else(|| "–".into());
     for &p in &pgas {
-        for r in runs.iter().filter(|r| r.spec.e_factor == 1.0 && r.spec.pga == p && r.spec.mesh == sweep && r.spec.layer == 1) {
-            let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
-            let level = format!("{}, {}", r.level, if r.spec.rigid_rock { "rigid rock" } else { "elastic rock" });
-            let (slip, mode) = match &r.failed {
-                Some(_) => (format!("≥ {} (stopped at t = {} s, see below)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))), r.mode.clone()),
-                None => (m(r.residual_slip), r.mode.clone()),
-            };
-            let _ = t.push_row([m(p), level, m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), mode, op]);
+        let mut row = vec![fmt_sig_short(p), val(&nts_sweep, p), val(&ntn_sweep, p)];
+        if has_nts2 {
+            row.push(val(&nts2_sweep, p));
         }
-        let rg = rigid_of(p);
-        let _ = t.push_row([m(p), "rigid block, cohesion lost".into(), "".into(), "".into(), "".into(), m(rg.brittle.result.residual_displacement), (if rg.brittle.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.brittle.result.n_episodes), "".into()]);
-        let _ = t.push_row([m(p), "rigid block, cohesion kept".into(), "".into(), "".into(), "".into(), m(rg.kept.result.residual_displacement), (if rg.kept.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.kept.result.n_episodes), "".into()]);
+        if has_ref {
+            row.push(val(&reference_pts, p));
+        }
+        let d = match (nts_sweep.iter().find(|x| x.0 == p), ntn_sweep.iter().find(|x| x.0 == p)) {
+            (Some(a), Some(b)) if a.1.max(b.1) >= 0.01 => fmt_percent((a.1 - b.1) / b.1, 1),
+            (Some(_), Some(_)) => "(< 1 cm)".into(),
+            _ => "–".into(),
+        };
+        let s = if p == seed::PGA {
+            format!("{} / {} ({})", seed::SLIP_NTS_1G, seed::SLIP_NTN_1G, fmt_percent((seed::SLIP_NTS_1G - seed::SLIP_NTN_1G) / seed::SLIP_NTN_1G, 1))
+        } else if p <= seed::NO_SLIDING_UP_TO {
+            "no obvious sliding".into()
+        } else {
+            "figure 11 only".into()
+        };
+        row.extend([m(rigid_main(p)), d, s]);
+        let _ = t.push_row(row);
     }
     md.push_str(&t.to_markdown());
+    let _ = writeln!(md, "\n![slip against PGA](charts/slip_vs_pga.svg)\n");
+    if acc == seed::PGA {
+        let _ = writeln!(md, "P1 residual displacement at {acc} g (x east, y north, z up):\n");
+        let mut t = Table::new(["level", "P1 ux", "P1 uy", "P1 uz", "seed", "angle to the seed's [°]", "onset of sliding [s]"]);
+        for (r, s) in [(nts_acc, seed::P1_NTS_1G), (ntn_acc, seed::P1_NTN_1G)] {
+            if let Some(r) = r {
+                let _ = t.push_row([r.level.clone(), m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), cm3(s), fmt_sig(angle_deg(r.p1_residual, s), 2), r.onset.map(|x| fmt_sig(x, 3)).unwrap_or_else(|| "–".into())]);
+            }
+        }
+        md.push_str(&t.to_markdown());
+        let _ = writeln!(md);
+    }
+    let _ = writeln!(md, "### The seed's claims\n");
+    let mut t = Table::new(["claim", "seed", "ours", "reproduced"]);
+    for c in &claims {
+        let _ = t.push_row([c.claim.clone(), c.seed.clone(), c.ours.clone(), match c.reproduced {
+            Some(true) => "yes".to_string(),
+            Some(false) => "no".into(),
+            None => "compare".into(),
+        }]);
+    }
+    md.push_str(&t.to_markdown());
+    let _ = writeln!(md, "\n\"Reproduced\": within 50 % for magnitudes, within 15° for the direction of P1; NTS − NTN as a sign and its growth with PGA. Why the numbers differ (record, duration, damping) is discussed in docs/wedge.md.\n");
+    for s in &trend {
+        let _ = writeln!(md, "- {s}");
+    }
+    let _ = writeln!(md);
+
+    let _ = writeln!(md, "### Headline runs in detail\n");
+    let joint_names = base.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(" / ");
+    let detail = |md: &mut String, sel: &dyn Fn(&WedgeRunSpec) -> bool, law: CohesionLaw| {
+        let mut t = Table::new(["PGA [g]".to_string(), "level".into(), "P1 ux".into(), "P1 uy".into(), "P1 uz".into(), "slip at P2".into(), "still sliding".into(), "failure mode".into(), format!("max opening {joint_names}")]);
+        for &p in &pgas {
+            if !runs.iter().any(|r| sel(&r.spec) && r.spec.pga == p && r.spec.mesh == sweep) {
+                continue;
+            }
+            for r in runs.iter().filter(|r| sel(&r.spec) && r.spec.pga == p && r.spec.mesh == sweep) {
+                let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
+                let slip = match &r.failed {
+                    Some(_) => format!("≥ {} (stopped at t = {} s, see below)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))),
+                    None => m(r.residual_slip),
+                };
+                let _ = t.push_row([fmt_sig_short(p), r.level.clone(), m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), r.mode.clone(), op]);
+            }
+            let rg = rigid_of(p).bond(law);
+            let _ = t.push_row([fmt_sig_short(p), format!("rigid block, {}", if law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), "".into(), "".into(), "".into(), m(rg.result.residual_displacement), (if rg.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.result.n_episodes), "".into()]);
+        }
+        md.push_str(&t.to_markdown());
+    };
+    detail(&mut md, &plain, main_law);
+    let _ = writeln!(md, "\n![slip history](charts/slip_history.svg)\n\n![P1 displacement](charts/p1_history.svg)\n");
+
+    // ---- 2. the variant law
+    if let Some(law) = other_law.filter(|_| !nts_var.is_empty() || !ntn_var.is_empty()) {
+        let _ = writeln!(md, "## Variant: {}\n", law.describe());
+        let _ = writeln!(md, "The same runs ({}, {sweep} mesh, β = {} s) with the joints' cohesion lost after slip: not the seed's law; residual slip at P2 [m].\n", main_rock.describe(), fmt_sig(main_beta, 3));
+        let mut t = Table::new(["PGA [g]".to_string(), format!("NTS-L1 {sweep}"), format!("NTN {sweep}"), "(NTS − NTN)/NTN".into(), "rigid block, cohesion lost at first slide".into(), format!("NTS-L1 {sweep}, headline")]);
+        for &p in pgas.iter().filter(|&&p| nts_var.iter().chain(&ntn_var).any(|x| x.0 == p)) {
+            let d = match (nts_var.iter().find(|x| x.0 == p), ntn_var.iter().find(|x| x.0 == p)) {
+                (Some(a), Some(b)) if a.1.max(b.1) >= 0.01 => fmt_percent((a.1 - b.1) / b.1, 1),
+                (Some(_), Some(_)) => "(< 1 cm)".into(),
+                _ => "–".into(),
+            };
+            let _ = t.push_row([fmt_sig_short(p), val(&nts_var, p), val(&ntn_var, p), d, m(rigid_of(p).bond(law).result.residual_displacement), val(&nts_sweep, p)]);
+        }
+        md.push_str(&t.to_markdown());
+        let _ = writeln!(md, "\n![slip against PGA, variant](charts/slip_vs_pga_variant.svg)\n");
+        let _ = writeln!(md, "### Variant runs in detail\n");
+        detail(&mut md, &variant, law);
+        let _ = writeln!(md);
+    }
+
+    // ---- 3. rock models
+    if !other_rock.is_empty() {
+        let _ = writeln!(md, "## Rock model: {} against the {}\n", others.iter().map(|r| r.describe()).collect::<Vec<_>>().join(", "), main_rock.describe());
+        let _ = writeln!(md, "Each run against the same run on the {} (residual slip at P2 [m]). Rock peak: the absolute acceleration of the rock node `{}` (peak over the run, x / y / z [g]); the rigid block driven by that computed motion (with the run's bond) shows how much of the change the rock's motion under the wedge explains.\n", main_rock.describe(), prm.monitors.rock);
+        let mut t = Table::new(["run", "slip", format!("slip, {}", main_rock.describe()).as_str(), "change", "rock peak x / y / z [g]", "rigid block on the rock's motion", "rigid block on the base record"]);
+        for r in &other_rock {
+            let tw = twin_of(r);
+            let pk = r.rock_peak_accel.map(|a| format!("{} / {} / {}", m(a[0]), m(a[1]), m(a[2]))).unwrap_or_else(|| "–".into());
+            let slip = if r.failed.is_some() { format!("failed (≥ {})", m(r.max_slip)) } else { m(r.residual_slip) };
+            let change = match tw {
+                Some(tw) if r.failed.is_none() && tw.residual_slip.abs().max(r.residual_slip.abs()) >= 0.01 => fmt_percent(r.residual_slip / tw.residual_slip - 1.0, 1),
+                Some(_) if r.failed.is_none() => "(< 1 cm)".into(),
+                _ => "–".into(),
+            };
+            let rb = rigid_of(r.spec.pga).bond(r.spec.law).result.residual_displacement;
+            let _ = t.push_row([r.spec.id.clone(), slip, tw.map(|x| m(x.residual_slip)).unwrap_or_else(|| "–".into()), change, pk, r.rigid_on_rock_slip.map(m).unwrap_or_else(|| "–".into()), m(rb)]);
+        }
+        md.push_str(&t.to_markdown());
+        let _ = writeln!(md, "\n![slip against PGA, rock models](charts/slip_vs_pga_rock.svg)\n");
+    }
+
+    // ---- 4. stiffness and damping
+    let _ = writeln!(md, "## Stiffness and damping (PGA {acc} g, {sweep} mesh, {})\n", main_rock.describe());
+    let mut t = Table::new(["run", "variant", "slip at P2", "same run, headline", "change"]);
+    for r in runs.iter().filter(|r| r.spec.pga == acc && r.spec.mesh == sweep && r.spec.rock == main_rock && r.spec.law == main_law && (r.spec.e_factor != 1.0 || r.spec.beta != main_beta)) {
+        let tw = run_of(&|s: &WedgeRunSpec| plain(s) && s.pga == acc && s.mesh == sweep && s.method == r.spec.method && s.layer == r.spec.layer);
+        let mut what = Vec::new();
+        if r.spec.e_factor != 1.0 {
+            what.push(format!("E × {}", r.spec.e_factor));
+        }
+        if r.spec.beta != main_beta {
+            what.push(if r.spec.beta == 0.0 { "undamped (β = 0)".to_string() } else { format!("β = {} s", fmt_sig(r.spec.beta, 3)) });
+        }
+        let _ = t.push_row([r.spec.id.clone(), what.join(", "), m(r.residual_slip), tw.map(|x| m(x.residual_slip)).unwrap_or_else(|| "–".into()), tw.map(|x| fmt_percent(r.residual_slip / x.residual_slip - 1.0, 1)).unwrap_or_else(|| "–".into())]);
+    }
+    md.push_str(&t.to_markdown());
+    let _ = writeln!(md);
+
+    let _ = writeln!(md, "## Speed against accuracy (PGA {acc} g, headline)\n");
+    let mut t = Table::new(["level", "wall time [s]", "slip [m]", "error vs reference", "Pareto front"]);
+    for (i, x) in sa.iter().enumerate() {
+        let _ = t.push_row([x.0.clone(), m(x.1), m(x.2), fmt_percent(x.3, 1), (if front.contains(&i) { "yes" } else { "" }).into()]);
+    }
+    if let Some(r) = ref_acc {
+        let _ = t.push_row([format!("{} (reference)", r.level), opt(r.wall_time), m(r.residual_slip), "0".into(), "".into()]);
+    }
+    md.push_str(&t.to_markdown());
+    let _ = writeln!(md, "\n![speed against accuracy](charts/speed_accuracy.svg)\n");
+    let _ = writeln!(md, "Cheapest level whose residual slip is within {} of the reference (or of 1 cm when the reference is smaller), at each PGA with a reference run:\n", fmt_percent(prm.enough, 0));
+    let mut t = Table::new(["PGA [g]", "cheapest sufficient level", "wall time [s]", "slip [m]"]);
+    for (p, l, w, s) in &cheapest {
+        let num = |x: f64| if x.is_finite() { m(x) } else { "–".to_string() };
+        let _ = t.push_row([fmt_sig_short(*p), l.clone(), num(*w), num(*s)]);
+    }
+    md.push_str(&t.to_markdown());
+    if ssr.is_some() {
+        let _ = writeln!(md, "\n![strength reduction](charts/ssr.svg)\n");
+    }
     let stopped: Vec<&WedgeRun> = runs.iter().filter(|r| r.failed.is_some()).collect();
     if !stopped.is_empty() || !stopped_early.is_empty() {
         let _ = writeln!(md, "\nRuns stopped by their checks (the slip they had reached is a lower bound):\n");
@@ -702,61 +1088,6 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
             let _ = writeln!(md, "- `{id}` (before its first history row): {f}");
         }
     }
-    let _ = writeln!(md, "\n![slip against PGA](charts/slip_vs_pga.svg)\n");
-    if !nts_other.is_empty() {
-        let _ = writeln!(md, "![slip against PGA, other rock model](charts/slip_vs_pga_other_rock.svg)\n");
-    }
-    let _ = writeln!(md, "![slip history](charts/slip_history.svg)\n\n![P1 displacement](charts/p1_history.svg)\n");
-    let _ = writeln!(md, "### Against the seed's trend\n");
-    for s in &trend {
-        let _ = writeln!(md, "- {s}");
-    }
-    let _ = writeln!(md);
-
-    let _ = writeln!(md, "## The rock's response under the wedge\n");
-    let _ = writeln!(md, "Peak absolute acceleration of the rock node `{}` below the line of intersection (NTS-L1 runs on the elastic rock, {sweep} mesh) against the PGA, and the rigid block driven by that computed motion instead of the base record (cohesion lost at the first slide): the part of the elastic-rock slip that the rock's own response explains. The rock box of `geo/wedge.geo` has fixed sides and bottom and no absorbing boundary, so its response is that of a closed box (resonant), not of a slope in a half-space.\n", prm.monitors.rock);
-    let mut t = Table::new(["PGA [g]", "rock peak x / y / z [g]", "amplification y / PGA", "rigid block on the base record", "rigid block on the rock's motion", "FEM NTS-L1"]);
-    for &p in &pgas {
-        if let Some(r) = find(&runs, |s| s.e_factor == 1.0 && !s.rigid_rock && s.pga == p && s.method == "nts" && s.mesh == sweep && s.layer == 1) {
-            let pk = r.rock_peak_accel.map(|a| format!("{} / {} / {}", m(a[0]), m(a[1]), m(a[2]))).unwrap_or_else(|| "–".into());
-            let amp = r.rock_peak_accel.map(|a| m(a[1] / p)).unwrap_or_else(|| "–".into());
-            let _ = t.push_row([m(p), pk, amp, m(rigid_of(p).brittle.result.residual_displacement), r.rigid_on_rock_slip.map(m).unwrap_or_else(|| "–".into()), m(r.residual_slip)]);
-        }
-    }
-    md.push_str(&t.to_markdown());
-    let _ = writeln!(md);
-
-    let _ = writeln!(md, "## Stiffness and rock model (PGA {acc} g, NTS-L1, {sweep} mesh; the main runs: {main_rock})\n");
-    let mut t = Table::new(["variant", "slip at P2", "change"]);
-    let base_slip = nts_acc.map(|r| r.residual_slip).unwrap_or(f64::NAN);
-    let _ = t.push_row(["E as given".to_string(), m(base_slip), "–".into()]);
-    for r in runs.iter().filter(|r| r.spec.pga == acc && r.spec.method == "nts" && r.spec.mesh == sweep && r.spec.layer == 1 && (r.spec.e_factor != 1.0 || r.spec.rigid_rock != rr)) {
-        let name = if r.spec.rigid_rock != rr { other_rock.to_string() } else { format!("E × {}", r.spec.e_factor) };
-        let _ = t.push_row([name, m(r.residual_slip), fmt_percent(r.residual_slip / base_slip - 1.0, 1)]);
-    }
-    md.push_str(&t.to_markdown());
-    let _ = writeln!(md);
-
-    let _ = writeln!(md, "## Speed against accuracy (PGA {acc} g)\n");
-    let mut t = Table::new(["level", "wall time [s]", "slip [m]", "error vs reference", "Pareto front"]);
-    for (i, x) in sa.iter().enumerate() {
-        let _ = t.push_row([x.0.clone(), m(x.1), m(x.2), fmt_percent(x.3, 1), (if front.contains(&i) { "yes" } else { "" }).into()]);
-    }
-    if let Some(r) = ref_acc {
-        let _ = t.push_row([format!("{} (reference)", r.level), opt(r.wall_time), m(r.residual_slip), "0".into(), "".into()]);
-    }
-    md.push_str(&t.to_markdown());
-    let _ = writeln!(md, "\n![speed against accuracy](charts/speed_accuracy.svg)\n");
-    let _ = writeln!(md, "Cheapest level whose residual slip is within {} of the reference (or of 1 cm when the reference is smaller), for each PGA:\n", fmt_percent(prm.enough, 0));
-    let mut t = Table::new(["PGA [g]", "cheapest sufficient level", "wall time [s]", "slip [m]"]);
-    for (p, l, w, s) in &cheapest {
-        let num = |x: f64| if x.is_finite() { m(x) } else { "–".to_string() };
-        let _ = t.push_row([m(*p), l.clone(), num(*w), num(*s)]);
-    }
-    md.push_str(&t.to_markdown());
-    if ssr.is_some() {
-        let _ = writeln!(md, "\n![strength reduction](charts/ssr.svg)\n");
-    }
     let _ = writeln!(md, "\n## Runs\n");
     let mut t = Table::new(["run".to_string(), "nodes".into(), "elements".into(), "dt [s]".into(), "steps".into(), "wall time [s]".into(), "slip [m]".into(), format!("lost node-steps {joint_names}")]);
     for r in &runs {
@@ -766,9 +1097,50 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         let _ = t.push_row([r.spec.id.clone(), count(r.nodes), count(r.elements), r.dt.map_or_else(|| "–".to_string(), |x| fmt_sig(x, 3)), count(r.steps), opt(r.wall_time), slip, lost]);
     }
     md.push_str(&t.to_markdown());
-    let lines = trend.clone();
-    let rep = WedgeReport { le, ssr, runs, rigid, cheapest, trend };
+    let total: f64 = runs.iter().filter_map(|r| r.wall_time).sum::<f64>() + ssr.as_ref().map_or(0.0, |s| s.wall_time);
+    let _ = writeln!(md, "\nSum of the runs' and the strength reduction's wall times (one thread each): {} s.", fmt_sig(total, 4));
+    let mut lines = trend.clone();
+    lines.extend(claims.iter().map(|c| format!("seed: {} — seed {}, ours {} ({})", c.claim, c.seed, c.ours, match c.reproduced {
+        Some(true) => "reproduced",
+        Some(false) => "not reproduced",
+        None => "compare",
+    })));
+    let rep = WedgeReport { le, ssr, runs, rigid, cheapest, trend, claims, headline_law: main_law, headline_beta: main_beta };
     Ok(KindReport { markdown: md, json: serde_json::to_value(&rep).expect("the report serialises"), charts, lines, unreadable, lists_failed: true })
+}
+
+/// (NTS − NTN)/NTN by PGA and how it compares with the seed's trend.
+fn nts_ntn_trend(label: &str, pgas: &[f64], nts: &[(f64, f64)], ntn: &[(f64, f64)]) -> Vec<String> {
+    let mut trend = Vec::new();
+    let pairs: Vec<(f64, f64, f64)> = pgas
+        .iter()
+        .filter_map(|&p| {
+            let a = nts.iter().find(|x| x.0 == p)?.1;
+            let b = ntn.iter().find(|x| x.0 == p)?.1;
+            Some((p, a, b))
+        })
+        .collect();
+    if pairs.is_empty() {
+        return trend;
+    }
+    let sliding: Vec<&(f64, f64, f64)> = pairs.iter().filter(|x| x.1.max(x.2) >= 0.01).collect();
+    let above = sliding.iter().filter(|x| x.1 >= x.2).count();
+    trend.push(format!("{label}: NTS ≥ NTN at {above} of the {} PGAs with slip ≥ 1 cm (seed: NTS above NTN at every PGA that slides).", sliding.len()));
+    let diffs: Vec<(f64, f64)> = sliding.iter().map(|x| (x.0, (x.1 - x.2) / x.2.max(1e-12))).collect();
+    if !diffs.is_empty() {
+        let growing = diffs.windows(2).all(|w| w[1].1 >= w[0].1);
+        trend.push(format!(
+            "{label}: (NTS − NTN)/NTN by PGA: {} — {} (seed: the difference grows with PGA).",
+            diffs.iter().map(|(p, d)| format!("{p} g: {}", fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
+            if growing { "grows with PGA" } else { "does not grow monotonically with PGA" }
+        ));
+    }
+    let none_below: Vec<f64> = pairs.iter().filter(|x| x.1.max(x.2) < 0.01).map(|x| x.0).collect();
+    trend.push(format!(
+        "{label}: no significant sliding (< 1 cm) at {} (seed: none at 0.5 g and below).",
+        if none_below.is_empty() { "no PGA".to_string() } else { none_below.iter().map(|p| format!("{p} g")).collect::<Vec<_>>().join(", ") }
+    ));
+    trend
 }
 
 fn damping_text(s: &Scene) -> String {
