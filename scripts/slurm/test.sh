@@ -132,7 +132,11 @@ sleep 1
 scancel "${job}_2"
 echo "scancel ${job}_2 ($victim)"
 wait_jobs 300
-[ ! -e "$T/slurm/runs/$victim/summary.json" ] || fail "the killed run finished before scancel (make JQ_SLURM_DURATION longer)"
+# scancel sends SIGTERM: the run finishes its current output and writes summary.json marked
+# `interrupted` (docs/cli.md), so a killed run has either no summary or an interrupted one
+python3 -c "import json,sys; s=json.load(open(sys.argv[1])); sys.exit(0 if s.get('interrupted') is not None else 1)" "$T/slurm/runs/$victim/summary.json" 2>/dev/null \
+    || [ ! -e "$T/slurm/runs/$victim/summary.json" ] \
+    || fail "the killed run finished before scancel (make JQ_SLURM_DURATION longer)"
 python3 - "$T/slurm/report.json" "$victim" "$T/slurm/runs/$victim.log" <<'PY' || fail "the killed run is not named as failed with its log"
 import json, sys
 rep, victim, log = json.load(open(sys.argv[1])), sys.argv[2], sys.argv[3]

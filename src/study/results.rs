@@ -93,6 +93,13 @@ impl RunResult {
                         RunStatus::Failed(if log.exists() && !e.contains(&*log.to_string_lossy()) { format!("{e} (log {})", log.display()) } else { e })
                     }
                     Err(_) => match RunSummary::read(&summary) {
+                        // a run stopped by Ctrl-C or SIGTERM writes its summary marked
+                        // `interrupted`: whole outputs up to there, but not a finished run
+                        Ok(s) if s.interrupted.is_some() => {
+                            let t = s.interrupted.unwrap_or(f64::NAN);
+                            sum = Some(s);
+                            RunStatus::Failed(format!("interrupted at t = {t} s (Ctrl-C or SIGTERM; log {}): its outputs end there", log.display()))
+                        }
                         Ok(s) => {
                             sum = Some(s);
                             RunStatus::Finished
