@@ -508,42 +508,9 @@ pub fn relax_gravity(
         solver.step(model, loads, state, Stage::Relaxation(alpha, scale), &mut *constraints)?;
         // after the step: u_nm1 = u[n−1], u_prev = u[n], u = u[n+1]; f_int = K u[n].
         // Out-of-balance force F − K u[n] + R[n] = M a[n] + α M v_b (contact forces included).
-        let mut r2 = 0.0;
-        let (mut ukb, mut umu) = (0.0, 0.0);
-        let f_int = solver.internal_force();
-        for i in 0..state.u.len() {
-            if model.is_free(i / 3, i % 3) {
-                let m = model.mass.inertial[i / 3];
-                let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
-                let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
-                let r = m * (a + alpha * vb) / scale;
-                r2 += r * r;
-                ukb += state.u_prev[i] * f_int[i];
-                umu += m * state.u_prev[i] * state.u_prev[i];
-            }
-        }
-        // block nodes: the out-of-balance force is M (a + α v_b) with the full inertia
-        for b in &model.mass.blocks {
-            let i0 = 3 * b.node as usize;
-            let mut av = nalgebra::Vector3::zeros();
-            for c in 0..3 {
-                let i = i0 + c;
-                if model.is_free(i / 3, c) {
-                    let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
-                    let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
-                    let r = model.mass.inertial[i / 3] * (a + alpha * vb) / scale;
-                    r2 -= r * r;
-                    av[c] = a + alpha * vb;
-                }
-            }
-            let r = b.full * av / scale;
-            r2 += (0..3).filter(|&c| model.is_free(b.node as usize, c)).map(|c| r[c] * r[c]).sum::<f64>();
-        }
+        let (r2, ukb, umu) = relaxation_balance(model, solver, state, alpha, scale);
         residual = r2.max(0.0).sqrt() / norm_f;
-        if umu > 0.0 && ukb > 0.0 {
-            // α = 2 ω_min, kept below the stability bound α dt < 1
-            alpha = (2.0 * (ukb / umu).sqrt()).min(0.5 / dt);
-        }
+        alpha = relaxation_damping(ukb, umu, dt, alpha);
         if residual < tol && k + 1 >= RELAXATION_RAMP_STEPS {
             state.u_prev.copy_from_slice(&state.u);
             return Ok(EquilibriumInfo { steps: k + 1, residual, converged: true });
@@ -551,4 +518,51 @@ pub fn relax_gravity(
     }
     state.u_prev.copy_from_slice(&state.u);
     Ok(EquilibriumInfo { steps: max_steps, residual, converged: false })
+}
+
+/// The out-of-balance measures of a relaxation step, once for [`relax_gravity`] and
+/// `staged::relax_static_increment`: after the step (u_nm1 = u[n−1], u_prev = u[n], u = u[n+1],
+/// f_int = K u[n]) the squared out-of-balance force ‖M (a[n] + α v_b) / scale‖² over the free
+/// components (block nodes with their full inertia; contact forces included), and the Rayleigh
+/// quotient's parts u·K u and u·M u.
+pub(crate) fn relaxation_balance(model: &Model, solver: &ExplicitSolver, state: &State, alpha: f64, scale: f64) -> (f64, f64, f64) {
+    let dt = solver.dt;
+    let mut r2 = 0.0;
+    let (mut ukb, mut umu) = (0.0, 0.0);
+    let f_int = solver.internal_force();
+    for i in 0..state.u.len() {
+        if model.is_free(i / 3, i % 3) {
+            let m = model.mass.inertial[i / 3];
+            let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
+            let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
+            let r = m * (a + alpha * vb) / scale;
+            r2 += r * r;
+            ukb += state.u_prev[i] * f_int[i];
+            umu += m * state.u_prev[i] * state.u_prev[i];
+        }
+    }
+    // block nodes: the out-of-balance force is M (a + α v_b) with the full inertia
+    for b in &model.mass.blocks {
+        let i0 = 3 * b.node as usize;
+        let mut av = nalgebra::Vector3::zeros();
+        for c in 0..3 {
+            let i = i0 + c;
+            if model.is_free(i / 3, c) {
+                let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
+                let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
+                let r = model.mass.inertial[i / 3] * (a + alpha * vb) / scale;
+                r2 -= r * r;
+                av[c] = a + alpha * vb;
+            }
+        }
+        let r = b.full * av / scale;
+        r2 += (0..3).filter(|&c| model.is_free(b.node as usize, c)).map(|c| r[c] * r[c]).sum::<f64>();
+    }
+    (r2, ukb, umu)
+}
+
+/// The relaxation's damping for the next step: α = 2 ω_min from the Rayleigh quotient, kept
+/// below the stability bound α dt < 1 (unchanged while the quotient is not positive).
+pub(crate) fn relaxation_damping(ukb: f64, umu: f64, dt: f64, alpha: f64) -> f64 {
+    if umu > 0.0 && ukb > 0.0 { (2.0 * (ukb / umu).sqrt()).min(0.5 / dt) } else { alpha }
 }

@@ -43,40 +43,9 @@ pub fn relax_static_increment(
             s.1 = f.1.map(|v| v * scale);
         }
         solver.step(model, &stage, state, Stage::Relaxation(alpha, 1.0), &mut *constraints)?;
-        let mut r2 = 0.0;
-        let (mut ukb, mut umu) = (0.0, 0.0);
-        let f_int = solver.internal_force();
-        for i in 0..state.u.len() {
-            if model.is_free(i / 3, i % 3) {
-                let m = model.mass.inertial[i / 3];
-                let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
-                let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
-                let r = m * (a + alpha * vb);
-                r2 += r * r;
-                ukb += state.u_prev[i] * f_int[i];
-                umu += m * state.u_prev[i] * state.u_prev[i];
-            }
-        }
-        for b in &model.mass.blocks {
-            let i0 = 3 * b.node as usize;
-            let mut av = nalgebra::Vector3::zeros();
-            for c in 0..3 {
-                let i = i0 + c;
-                if model.is_free(i / 3, c) {
-                    let a = (state.u[i] - 2.0 * state.u_prev[i] + solver.u_nm1[i]) / (dt * dt);
-                    let vb = (state.u_prev[i] - solver.u_nm1[i]) / dt;
-                    let r = model.mass.inertial[i / 3] * (a + alpha * vb);
-                    r2 -= r * r;
-                    av[c] = a + alpha * vb;
-                }
-            }
-            let r = b.full * av;
-            r2 += (0..3).filter(|&c| model.is_free(b.node as usize, c)).map(|c| r[c] * r[c]).sum::<f64>();
-        }
+        let (r2, ukb, umu) = super::relaxation_balance(model, solver, state, alpha, 1.0);
         residual = r2.max(0.0).sqrt() / norm_f;
-        if umu > 0.0 && ukb > 0.0 {
-            alpha = (2.0 * (ukb / umu).sqrt()).min(0.5 / dt);
-        }
+        alpha = super::relaxation_damping(ukb, umu, dt, alpha);
         if residual < tol && k + 1 >= ramp_steps {
             state.u_prev.copy_from_slice(&state.u);
             return Ok(EquilibriumInfo { steps: k + 1, residual, converged: true });
