@@ -33,7 +33,7 @@ use super::query::{project_along_on_quad_from, project_along_on_tri, select_proj
 use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
 use crate::model::Model;
-use nalgebra::{Vector2, Vector3};
+use nalgebra::{Matrix3, Vector2, Vector3};
 
 /// Per model node: where it is among the nodes of this step's active pairs.
 #[derive(Clone, Copy, Debug, Default)]
@@ -101,7 +101,13 @@ struct Active {
     mob2_max: f64,
     /// The same five nodes as indices into the solver's local nodes ([`LocalNode`]).
     local: [u32; 5],
+    /// [`NO_ANISO`], or the index of the pair's five move matrices in
+    /// `ContactSolver::aniso` when one of its nodes has an inertia block.
+    aniso: u32,
 }
+
+/// `Active::aniso` of a pair with no inertia-block node (its moves are `mob` × the force).
+const NO_ANISO: u32 = u32::MAX;
 
 impl Active {
     /// The pair's relative displacement Σ N_I x_I − x_s over the local nodes (five terms
@@ -118,9 +124,16 @@ impl Active {
     /// Move the pair's local nodes by the displacements a pair force `r` (N, on the slave) makes
     /// over one step (`mob`: 0 at a fixed node or an unused entry).
     #[inline(always)]
-    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>) {
-        for b in 0..5 {
-            local[self.local[b] as usize].x += r * self.mob[b];
+    fn move_nodes_into(&self, local: &mut [LocalNode], aniso: &[[Matrix3<f64>; 5]], r: &Vector3<f64>) {
+        if self.aniso == NO_ANISO {
+            for b in 0..5 {
+                local[self.local[b] as usize].x += r * self.mob[b];
+            }
+        } else {
+            let m = &aniso[self.aniso as usize];
+            for b in 0..5 {
+                local[self.local[b] as usize].x += m[b] * r;
+            }
         }
     }
 }
@@ -191,6 +204,9 @@ pub struct ContactSolver<'m> {
     /// (the convergence test takes the net change of each node over a sweep).
     local: Vec<LocalNode>,
     local_global: Vec<u32>,
+    /// Per step: the five move matrices dt² M⁻¹ (slave) and −dt² N_I M_I⁻¹ (masters) of each
+    /// active pair that has a node with an inertia block ([`Active::aniso`]).
+    aniso: Vec<[Matrix3<f64>; 5]>,
     sweep_start: Vec<Vector3<f64>>,
 }
 
@@ -202,13 +218,13 @@ impl<'m> ContactSolver<'m> {
             .map(|n| if model.fixed[n] == 0 && mass.inertial[n] > 0.0 { 1.0 / mass.inertial[n] } else { 0.0 })
             .collect();
         // a block node: its largest inverse mass (for the penalty bound and the colouring's
-        // test of a moving node); the pairs read it along their normal (`inverse_mass_along`)
+        // test of a moving node); the pairs' laws read it as their mobility in every direction
         let block_nodes: Vec<u32> = mass.blocks.iter().filter(|b| model.fixed[b.node as usize] == 0).map(|b| b.node).collect();
         for b in &mass.blocks {
             let n = b.node as usize;
             inv_mass[n] = if model.fixed[n] == 0 { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
         }
-        ContactSolver { block_nodes, joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { block_nodes, joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new(), aniso: Vec::new() }
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -229,19 +245,6 @@ impl<'m> ContactSolver<'m> {
             }
         }
         row.into_iter().fold(0.0, f64::max)
-    }
-
-    /// The inverse mass a pair with normal `n` reads at `node` [1/kg]: 1/m (0 at a fixed node),
-    /// or at a node with an inertia block n · M⁻¹ n, its inverse mass along the pair's normal
-    /// (docs/contact.md, "Mobility of an anisotropic mass"). One test of an empty list for the
-    /// models without blocks.
-    #[inline(always)]
-    fn inverse_mass_along(&self, model: &Model, node: usize, n: &Vector3<f64>) -> f64 {
-        if self.block_nodes.is_empty() || self.block_nodes.binary_search(&(node as u32)).is_err() {
-            self.inv_mass[node]
-        } else {
-            model.mass.inverse_along(node, n)
-        }
     }
 
     /// The joint's law as it applies now: with [`Self::keep_bonds`] its bond is kept.
@@ -463,7 +466,7 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
 /// loop rather than a test per pair, so that the full pass carries nothing of the list.
 #[inline(never)] // its own code, whatever the code around it (a sweep is long; one call per sweep)
 #[allow(clippy::too_many_arguments)]
-fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64) -> usize {
+fn sweep_pass<const LISTED: bool>(active: &mut [Active], aniso: &[[Matrix3<f64>; 5]], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64) -> usize {
     let mut moving = 0;
     for &k in order.iter() {
         let k = k as usize;
@@ -494,15 +497,16 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
         // |du|² = |dr|² mob²: one norm per pair instead of one per node
         let dr2 = dr.norm_squared();
         if LISTED {
+            // (mob is the mobility along the pair's normal; at a block node no direction moves
+            // more than 1/m, the same bound within the block's added-mass ratio)
             for b in 0..5 {
                 let l = &mut local[a.local[b] as usize];
                 l.moved_at = l.moved_at.max(*clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
-                l.x += dr * a.mob[b];
             }
         } else {
             moving += (dr2 * a.mob2_max > mark_tol2) as usize;
-            a.move_nodes_into(local, &dr);
         }
+        a.move_nodes_into(local, aniso, &dr);
         let e = &mut active[k];
         e.gap = g_trial + e.dt2w * resp.r_n;
         e.r_n = resp.r_n;
@@ -526,6 +530,7 @@ impl ContactSolver<'_> {
     #[inline(never)] // out of line, so that profiles show the four parts of a step
     fn search_into(&mut self, model: &Model, history: &mut ContactState, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> f64 {
         self.active.clear();
+        self.aniso.clear();
         self.penalty.clear();
         let mut penalty_work = 0.0;
         // ---------------------------------------------------------------- search
@@ -665,11 +670,11 @@ impl ContactSolver<'_> {
                         }
                     }
                 };
-                let ims = self.inverse_mass_along(model, s, &n);
+                let ims = self.inv_mass[s];
                 let mut imm = [0.0; 4];
                 let mut w = ims;
                 for a in 0..nm as usize {
-                    imm[a] = self.inverse_mass_along(model, masters[a] as usize, &n);
+                    imm[a] = self.inv_mass[masters[a] as usize];
                     w += weights[a] * weights[a] * imm[a];
                 }
                 if w == 0.0 {
@@ -731,7 +736,28 @@ impl ContactSolver<'_> {
                         mob[b + 1] = -dt2 * weights[b] * imi;
                     }
                 }
+                // a pair on a node with an inertia block moves its nodes by dt² M⁻¹ × the
+                // force (the full block, on the free components), while its law reads the
+                // node's largest inverse mass as its mobility: each update under-corrects the
+                // directions the block makes heavier, never over-corrects, and the sweeps
+                // converge to the forces of the true inertia (docs/contact.md, "Mobility of an
+                // anisotropic mass")
+                let mut aniso_index = NO_ANISO;
+                if !self.block_nodes.is_empty() && nodes5[..=nm as usize].iter().any(|nd| self.block_nodes.binary_search(nd).is_ok()) {
+                    let mut m = [Matrix3::zeros(); 5];
+                    for b in 0..=nm as usize {
+                        let nd = nodes5[b] as usize;
+                        let scale = if b == 0 { dt2 } else { -dt2 * weights[b - 1] };
+                        m[b] = match model.mass.block_of(nd) {
+                            Some(blk) if self.inv_mass[nd] > 0.0 => blk.inverse * scale,
+                            _ => Matrix3::identity() * (scale * self.inv_mass[nd]),
+                        };
+                    }
+                    aniso_index = self.aniso.len() as u32;
+                    self.aniso.push(m);
+                }
                 self.active.push(Active {
+                    aniso: aniso_index,
                     nodes: nodes5,
                     local: [0; 5],
                     mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
@@ -803,7 +829,7 @@ impl ContactSolver<'_> {
         self.step_clock += 1;
         self.local.clear();
         self.local_global.clear();
-        let ContactSolver { active, node, local, local_global, step_clock, .. } = self;
+        let ContactSolver { active, aniso, node, local, local_global, step_clock, .. } = self;
         for a in active.iter_mut() {
             // the pair's nodes among the local nodes, copied from the prediction when first met
             for b in 0..5 {
@@ -823,7 +849,7 @@ impl ContactSolver<'_> {
             if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
                 let [n, t1, t2] = a.frame;
                 let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                a.move_nodes_into(local, &r);
+                a.move_nodes_into(local, aniso, &r);
             }
         }
         if self.gs_colored {
@@ -848,7 +874,7 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
+        let ContactSolver { active, aniso, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
         for (x0, l) in sweep_start.iter_mut().zip(local.iter()) {
@@ -872,9 +898,9 @@ impl ContactSolver<'_> {
                 local.iter_mut().for_each(|l| l.moved_at = clock);
             }
             moving = if listed {
-                sweep_pass::<true>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
+                sweep_pass::<true>(active, aniso, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
             } else {
-                sweep_pass::<false>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
+                sweep_pass::<false>(active, aniso, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
             };
             let max_du = sweep_change_into(local, sweep_start).sqrt();
             residual = max_du;
