@@ -58,6 +58,49 @@ pub struct Bonding {
     pub info: TieInfo,
 }
 
+/// How a slave node found its master point ([`master_point`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MasterHit {
+    /// On a Layer2 face within the joint's `edge_tolerance`.
+    Projected,
+    /// On a Layer2 face within half a face.
+    Widened,
+    /// No face: the nearest master node O (weight 1).
+    NearestNode,
+}
+
+/// The master point of slave node `i` of joint `j` on the initial configuration, as the
+/// model nodes of its face and their weights N_I (the rule of this module's header: the
+/// joint's edge tolerance, then half a face, then O).
+pub fn master_point(model: &Model, j: &ContactJoint, i: usize) -> Result<(Vec<(usize, f64)>, MasterHit), ModelError> {
+    let m = &j.tag.master;
+    let s = j.tag.slave_nodes()[i];
+    let xs = Vector3::from(model.mesh.nodes[s]);
+    let n = j.frames[i][0];
+    let faces: Vec<(usize, Vec<Vector3<f64>>)> = j
+        .tag
+        .layer2
+        .row(i)
+        .iter()
+        .map(|&f| {
+            let (x, k) = m.face_points(f as usize);
+            (f as usize, x[..k].iter().map(|p| Vector3::from(*p)).collect())
+        })
+        .collect();
+    let project = |tol: f64| -> Result<Option<(usize, crate::contact::query::Projection)>, ModelError> {
+        select_projection(&xs, &n, faces.iter().map(|(f, x)| (*f, x.as_slice())), tol)
+            .map_err(|e| ModelError::Invalid(format!("joint \"{}\", slave node {}: {e}", j.tag.name, model.mesh.node_tags[s])))
+    };
+    let on_face = |f: usize, p: crate::contact::query::Projection| m.faces[f].nodes().iter().zip(p.weights).map(|(&nd, w)| (nd as usize, w)).collect();
+    Ok(if let Some((f, p)) = project(j.edge_tolerance)? {
+        (on_face(f, p), MasterHit::Projected)
+    } else if let Some((f, p)) = project(0.5)? {
+        (on_face(f, p), MasterHit::Widened)
+    } else {
+        (vec![(j.tag.nearest_master_node(i), 1.0)], MasterHit::NearestNode)
+    })
+}
+
 /// Per slave node its masters (model nodes) and weights, for the joints `bonded`.
 fn tie_nodes(model: &Model, joints: &[&ContactJoint]) -> Result<(Vec<Option<Vec<(usize, f64)>>>, TieInfo), ModelError> {
     let mut ties: Vec<Option<Vec<(usize, f64)>>> = vec![None; model.n_nodes()];
@@ -65,38 +108,17 @@ fn tie_nodes(model: &Model, joints: &[&ContactJoint]) -> Result<(Vec<Option<Vec<
     let mut order: Vec<&&ContactJoint> = joints.iter().filter(|j| j.law.tied).collect();
     order.extend(joints.iter().filter(|j| !j.law.tied));
     for j in order {
-        let m = &j.tag.master;
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
             if ties[s].is_some() {
                 info.already_tied += 1;
                 continue;
             }
-            let xs = Vector3::from(model.mesh.nodes[s]);
-            let n = j.frames[i][0];
-            let faces: Vec<(usize, Vec<Vector3<f64>>)> = j
-                .tag
-                .layer2
-                .row(i)
-                .iter()
-                .map(|&f| {
-                    let (x, k) = m.face_points(f as usize);
-                    (f as usize, x[..k].iter().map(|p| Vector3::from(*p)).collect())
-                })
-                .collect();
-            let project = |tol: f64| -> Result<Option<(usize, crate::contact::query::Projection)>, ModelError> {
-                select_projection(&xs, &n, faces.iter().map(|(f, x)| (*f, x.as_slice())), tol)
-                    .map_err(|e| ModelError::Invalid(format!("bonding joint \"{}\", slave node {}: {e}", j.tag.name, model.mesh.node_tags[s])))
-            };
-            let masters = if let Some((f, p)) = project(j.edge_tolerance)? {
-                info.projected += 1;
-                m.faces[f].nodes().iter().zip(p.weights).map(|(&nd, w)| (nd as usize, w)).collect()
-            } else if let Some((f, p)) = project(0.5)? {
-                info.widened += 1;
-                m.faces[f].nodes().iter().zip(p.weights).map(|(&nd, w)| (nd as usize, w)).collect()
-            } else {
-                info.nearest_node += 1;
-                vec![(j.tag.nearest_master_node(i), 1.0)]
-            };
+            let (masters, hit) = master_point(model, j, i)?;
+            match hit {
+                MasterHit::Projected => info.projected += 1,
+                MasterHit::Widened => info.widened += 1,
+                MasterHit::NearestNode => info.nearest_node += 1,
+            }
             ties[s] = Some(masters);
             info.tied += 1;
         }
@@ -173,25 +195,7 @@ impl Bonding {
                 }
             }
         }
-        let mut col_ptr = Vec::with_capacity(self.n + 1);
-        col_ptr.push(0);
-        let mut row = Vec::new();
-        let mut val = Vec::new();
-        for c in cols.iter_mut() {
-            c.sort_unstable_by_key(|e| e.0);
-            let mut last = NONE;
-            for &(r, v) in c.iter() {
-                if r == last {
-                    *val.last_mut().unwrap() += v;
-                } else {
-                    row.push(r);
-                    val.push(v);
-                    last = r;
-                }
-            }
-            col_ptr.push(row.len());
-        }
-        Csc { n_rows: self.n, n_cols: self.n, col_ptr, row, val }
+        crate::linalg::from_columns(self.n, cols)
     }
 
     /// Tᵀ f for a vector over every model dof.

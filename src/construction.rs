@@ -13,9 +13,9 @@
 //!   (b) **grouting**: every joint that is not tied closes at the deformed state, with the gap
 //!   measured there (`PairRecord::gap_offset` = the gap along the slave normal to the deformed
 //!   master surface), so it starts closed with no force and keeps its own law (Mohr–Coulomb).
-//!   (c) **the static forces** (the reservoir's hydrostatic pressure): the linear response with
-//!   every joint bonded as the start, then dynamic relaxation with the joints active (their
-//!   Mohr–Coulomb law: pairs may open or slip) and gravity kept (`dynamics::staged`).
+//!   (c) **the static forces** (the reservoir's hydrostatic pressure) with the joints active
+//!   (their Mohr–Coulomb law: pairs may open or slip), gravity kept: an active-set direct
+//!   solve from the grouted state (`static_contact`).
 //!
 //! Grouting: a joint is grouted pair by pair; a slave node that finds no master face (even
 //! within half a face) keeps offset 0 and is counted.
@@ -23,16 +23,15 @@
 //! Each stage's residual and method are in the returned [`SequenceReport`] and the run's notes.
 
 use crate::bonded::Bonding;
-use crate::constraint::Constraint;
 use crate::contact::joint::ContactJoint;
 use crate::contact::query::select_projection;
 use crate::contact::ContactState;
-use crate::dynamics::staged::relax_static_increment;
 use crate::dynamics::EquilibriumInfo;
 use crate::error::{Error, ModelError};
 use crate::linalg::{stiffness, SparseCholesky};
 use crate::problem::Problem;
 use crate::simulation::Simulation;
+use crate::static_contact::solve_static_increment;
 use nalgebra::Vector3;
 
 /// One stage of the sequence.
@@ -103,6 +102,12 @@ pub fn self_weight_open_joints(problem: &Problem) -> Result<(Vec<f64>, StageRepo
 /// offset becomes its gap there. Returns the stage's report (largest |offset|, pairs without
 /// a master face).
 pub fn grout(problem: &Problem, contact: &mut ContactState, u: &[f64]) -> Result<StageReport, Error> {
+    grout_pairs(problem, contact, u, |_, _| true)
+}
+
+/// Grout the pairs (joint, slave index) for which `which` holds, of every joint that is not
+/// tied, at the displacements `u` (as [`grout`]).
+pub fn grout_pairs(problem: &Problem, contact: &mut ContactState, u: &[f64], which: impl Fn(usize, usize) -> bool) -> Result<StageReport, Error> {
     let model = &problem.model;
     let (mut pairs, mut missed, mut largest) = (0usize, 0usize, 0.0f64);
     for (ji, j) in problem.joints.iter().enumerate() {
@@ -112,6 +117,9 @@ pub fn grout(problem: &Problem, contact: &mut ContactState, u: &[f64]) -> Result
         let m = &j.tag.master;
         let pos = |node: usize| Vector3::new(model.mesh.nodes[node][0] + u[3 * node], model.mesh.nodes[node][1] + u[3 * node + 1], model.mesh.nodes[node][2] + u[3 * node + 2]);
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
+            if !which(ji, i) {
+                continue;
+            }
             let xs = pos(s);
             let n = j.frames[i][0];
             let faces: Vec<(usize, Vec<Vector3<f64>>)> = j.tag.layer2.row(i).iter().map(|&f| (f as usize, m.faces[f as usize].nodes().iter().map(|&nd| pos(nd as usize)).collect())).collect();
@@ -150,54 +158,49 @@ pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
             sim.state.u_prev.copy_from_slice(&u);
             stages.push(a);
             stages.push(grout(p, &mut sim.state.contact, &u)?);
-            // (c) starts from the linear response to the static forces with every joint bonded
-            // (the grouted joints closed and stuck): under the reservoir an arch dam's joints
-            // are mostly in compression, so this is near the answer, and the relaxation then
-            // only resolves the pairs that open or slip, with the whole load from its first
-            // step. (Ramped in from rest, the relaxation had not converged on the arch dam:
-            // residual 5.4e-2 after 40 000 steps.)
+            // (c) the static forces with the joints active: an active-set direct solve
+            // (`static_contact`). Dynamic relaxation, started from the linear response with
+            // every joint bonded, had not converged on the arch dam (residual 2.2e-2 after
+            // 40 000 steps; 5.4e-2 ramped in from rest).
             let mut f_static = vec![0.0; u.len()];
             for &(n, fv) in &p.loads.static_forces {
                 for c in 0..3 {
                     f_static[3 * n + c] += fv[c];
                 }
             }
-            let all: Vec<&ContactJoint> = p.joints.iter().collect();
-            let (du, linear_residual, _) = linear_static(p, &all, &f_static)?;
+            let (du, info) = solve_static_increment(p, &f_static, &mut sim.state.contact, crate::static_contact::PENALTY_FACTOR)?;
+            if !info.converged {
+                return Err(ModelError::Invalid(format!(
+                    "static sequence, stage c (static forces with the joints active): not converged ({}). The joints' contact states cycle: check the joints' friction and the load",
+                    info.line()
+                ))
+                .into());
+            }
             for (x, d) in sim.state.u.iter_mut().zip(&du) {
                 *x += d;
             }
             sim.state.u_prev.copy_from_slice(&sim.state.u);
-            if let Some(c) = sim.contact.as_mut() {
-                c.keep_bonds = sc.equilibrium.joint_bonds == "kept";
-            }
-            let eq = {
-                let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(2);
-                if let Some(c) = sim.contact.as_mut() {
-                    cs.push(c);
+            // the closed pairs carry the penalty's small penetration (info.max_penetration);
+            // the explicit run's contact is exact and would push it out in one step, so they
+            // are re-grouted where they are: the dynamic stage starts with them touching.
+            let closed: Vec<Vec<bool>> = sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| r.state != crate::contact::law::PairState::Open).collect()).collect();
+            let (forces, gaps): (Vec<Vec<(f64, [f64; 2])>>, Vec<Vec<f64>>) =
+                (sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| (r.r_n, r.r_t)).collect()).collect(), sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| r.gap).collect()).collect());
+            grout_pairs(p, &mut sim.state.contact, &sim.state.u, |ji, i| closed[ji][i])?;
+            for (ji, j) in sim.state.contact.joints.iter_mut().enumerate() {
+                for (i, r) in j.pairs.iter_mut().enumerate() {
+                    (r.r_n, r.r_t) = forces[ji][i];
+                    r.gap = if closed[ji][i] { 0.0 } else { gaps[ji][i] };
                 }
-                if let Some(f) = sim.foundation.as_mut() {
-                    cs.push(f);
-                }
-                relax_static_increment(&p.model, &p.loads, &mut sim.solver, &mut sim.state, &mut cs, sc.equilibrium.tolerance, sc.equilibrium.max_steps, 0)?
-            };
-            if let Some(c) = sim.contact.as_mut() {
-                c.keep_bonds = false;
-            }
-            if !eq.converged && eq.residual > sc.equilibrium.max_residual {
-                return Err(ModelError::Invalid(format!(
-                    "static sequence, stage c (static forces with the joints active): equilibrium not reached in {} steps, residual {:.2e} > max_residual {:.1e}. Raise equilibrium.max_steps",
-                    eq.steps, eq.residual, sc.equilibrium.max_residual
-                ))
-                .into());
             }
             stages.push(StageReport {
                 name: "c: static forces (reservoir), joints active".into(),
-                method: "linear solve with the joints bonded, then relaxation".into(),
-                residual: eq.residual,
-                steps: eq.steps,
-                note: format!("bonded start residual {linear_residual:.1e}{}", if eq.converged { String::new() } else { format!("; above tolerance {:.1e} (accepted below max_residual)", sc.equilibrium.tolerance) }),
+                method: "Newton, direct solves (penalty contact)".into(),
+                residual: info.residual,
+                steps: 0,
+                note: info.line(),
             });
+            let eq = EquilibriumInfo { steps: 0, residual: info.residual, converged: true };
             sim.restart_clock();
             sim.state.contact.restart_slip();
             sim.equilibrium = Some(EquilibriumInfo { steps: eq.steps, residual: eq.residual, converged: eq.converged });

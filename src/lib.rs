@@ -59,6 +59,7 @@ pub mod reservoir;
 pub mod rigid;
 pub mod scene;
 pub mod simulation;
+pub mod static_contact;
 pub mod studies;
 pub mod scene_patterns;
 pub mod study;

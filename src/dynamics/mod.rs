@@ -19,7 +19,6 @@
 //! `energy_tolerance` × the energy scale) or unbounded growth stops the run.
 
 pub mod loads;
-pub mod staged;
 pub mod record;
 pub mod time;
 
@@ -520,8 +519,7 @@ pub fn relax_gravity(
     Ok(EquilibriumInfo { steps: max_steps, residual, converged: false })
 }
 
-/// The out-of-balance measures of a relaxation step, once for [`relax_gravity`] and
-/// `staged::relax_static_increment`: after the step (u_nm1 = u[n−1], u_prev = u[n], u = u[n+1],
+/// The out-of-balance measures of a relaxation step ([`relax_gravity`]): after the step (u_nm1 = u[n−1], u_prev = u[n], u = u[n+1],
 /// f_int = K u[n]) the squared out-of-balance force ‖M (a[n] + α v_b) / scale‖² over the free
 /// components (block nodes with their full inertia; contact forces included), and the Rayleigh
 /// quotient's parts u·K u and u·M u.

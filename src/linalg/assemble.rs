@@ -358,3 +358,37 @@ pub(crate) mod tests {
         assert_eq!(mm[(11, 11)], m.mass.inertial[3]);
     }
 }
+
+/// A + E for a square matrix `a` and extra entries `extra` (row, column, value), duplicates
+/// summed; the pattern grows where E has entries outside A's.
+pub fn add_entries(a: &Csc, extra: &[(usize, usize, f64)]) -> Csc {
+    let mut cols: Vec<Vec<(usize, f64)>> = (0..a.n_cols).map(|j| (a.col_ptr[j]..a.col_ptr[j + 1]).map(|p| (a.row[p], a.val[p])).collect()).collect();
+    for &(i, j, v) in extra {
+        cols[j].push((i, v));
+    }
+    from_columns(a.n_rows, cols)
+}
+
+/// The matrix whose column j holds the entries `cols[j]` (row, value) in any order, duplicates
+/// summed.
+pub fn from_columns(n_rows: usize, mut cols: Vec<Vec<(usize, f64)>>) -> Csc {
+    let nnz = cols.iter().map(|c| c.len()).sum();
+    let mut col_ptr = Vec::with_capacity(cols.len() + 1);
+    col_ptr.push(0);
+    let (mut row, mut val) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
+    for c in cols.iter_mut() {
+        c.sort_unstable_by_key(|e| e.0);
+        let mut last = usize::MAX;
+        for &(r, v) in c.iter() {
+            if r == last {
+                *val.last_mut().unwrap() += v;
+            } else {
+                row.push(r);
+                val.push(v);
+                last = r;
+            }
+        }
+        col_ptr.push(row.len());
+    }
+    Csc { n_rows, n_cols: cols.len(), col_ptr, row, val }
+}

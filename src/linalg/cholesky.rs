@@ -128,3 +128,17 @@ mod tests {
         }
     }
 }
+
+/// x ← A⁻¹ x for a square sparse matrix that need not be symmetric (faer's sparse LU with
+/// partial pivoting; symbolic and numeric factorisation on every call). `what` names the
+/// matrix in errors.
+pub fn lu_solve_in_place(a: &Csc, x: &mut [f64], what: &str) -> Result<(), LinalgError> {
+    use faer::linalg::solvers::Solve;
+    let n = a.n_rows;
+    if a.n_cols != n || x.len() != n {
+        return Err(LinalgError::Invalid(format!("{what}: a {n}×{} matrix with a right-hand side of {}", a.n_cols, x.len())));
+    }
+    let lu = a.as_faer().sp_lu().map_err(|e| LinalgError::Invalid(format!("{what}: sparse LU failed ({e:?}): the model can move without deforming, or the matrix is singular")))?;
+    lu.solve_in_place(MatMut::from_column_major_slice_mut(x, n, 1));
+    Ok(())
+}

@@ -19,8 +19,8 @@ pub mod assemble;
 pub mod cholesky;
 pub mod eigen;
 
-pub use assemble::{dof_map, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
-pub use cholesky::SparseCholesky;
+pub use assemble::{add_entries, dof_map, from_columns, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
+pub use cholesky::{lu_solve_in_place, SparseCholesky};
 pub use eigen::{lowest_modes, Modes, ModesOptions};
 
 /// Failures of the sparse linear algebra, each with what to change.

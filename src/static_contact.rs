@@ -1,0 +1,320 @@
+//! A static load increment on a structure whose joints are active (Mohr–Coulomb contact):
+//! the stage of a construction sequence that brings the reservoir onto the grouted dam
+//! (`construction`, stage c).
+//!
+//! Method: a penalty contact law solved by Newton's method with direct solves, as implicit
+//! static codes do it (e.g. Abaqus/Standard's penalty contact with its contact-state
+//! iterations). Each pair of a joint that is not tied carries a force q(w) that is a continuous,
+//! piecewise-linear function of its relative motion w; the out-of-balance force of the model
+//! with these forces is driven to zero by u ← u + K_T⁻¹ R(u), with K_T the stiffness plus each
+//! pair's tangent (sparse Cholesky on the model with the tied joints eliminated, `bonded`).
+//!
+//! Conventions (written once, here): w = Σ_I N_I Δu_I − Δu_s is the master point's motion
+//! relative to the slave node over the increment, with N_I the weights of the pair's master
+//! point (`bonded::master_point` for node-to-segment joints, the nearest master node O for
+//! node-to-node); n is the slave normal (towards the master), so the gap is g = n · w (the
+//! increment starts from a grouted joint: gap 0 with no force), w_t = w − g n, and the normal
+//! force is r_n = −k g (compressive positive). q is the force on the slave node (−N_I q on the
+//! masters). Forces in N, displacements in m.
+//! - **open** (r_n < −σ_t A: tension beyond the tensile strength, 0 for the dam): q = 0;
+//! - **stick** (k |w_t| ≤ L, L = `JointLaw::shear_limit`(r_n)): q = k w, tangent k I;
+//! - **slip**: q = k g n + L w_t/|w_t|, tangent k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) − μ k t̂ nᵀ,
+//!   t̂ = w_t/|w_t|. The last term (the limit grows with the normal force) makes K_T
+//!   unsymmetric, so the solves are sparse LU; without it Newton diverged on the coarse dam
+//!   (it is of the penalty's size).
+//!
+//! This friction law is holonomic (deformation theory): the increment is one proportional
+//! load, applied at once, so the slip direction is that of the total relative tangential
+//! motion, as in a one-increment implicit step.
+//!
+//! Penalty: k = [`PENALTY_FACTOR`] × the mean diagonal stiffness of the slave node's dofs. The
+//! springs' compliance is then 1/1000 of the node's own, so the joint moves by that fraction
+//! more than a rigid contact would: the displacements and stresses carry an error of that order,
+//! far below the mesh's discretisation error (measured on the coarse dam: docs/dam.md).
+//!
+//! The residual is ‖R‖ / ‖F‖ on the free unknowns with the contact forces included (converged
+//! below [`TOLERANCE`]); the report adds the largest penetration, the pairs in each state and
+//! the pairs held closed ([`CHATTER_CHANGES`]).
+
+use crate::bonded::{master_point, Bonding, MasterHit};
+use crate::contact::joint::{ContactJoint, Method};
+use crate::contact::law::{PairHistory, PairState};
+use crate::contact::ContactState;
+use crate::error::{Error, ModelError};
+use crate::linalg::{add_entries, lu_solve_in_place, stiffness};
+use crate::problem::Problem;
+use nalgebra::{Matrix3, Vector3};
+
+/// Penalty stiffness of a pair, as a multiple of the mean diagonal stiffness of its slave
+/// node (dimensionless): 1000. Why: stiff enough that the joint's compliance is 1e-3 of the
+/// mesh's next to it (the error it adds), soft enough that the condition number stays within
+/// 1e3 of the model's (the solves keep a residual near 1e-11).
+pub const PENALTY_FACTOR: f64 = 1e3;
+
+/// Converged when ‖R‖ / ‖F‖ (the out-of-balance force with the contact forces, relative to
+/// the load) is below this (dimensionless): 1e-8. Why: six orders below what the stresses
+/// need, two above the solves' round-off.
+pub const TOLERANCE: f64 = 1e-8;
+
+/// Largest number of Newton iterations: 200. Why: on the coarse dam the iteration converges
+/// in a few tens (docs/dam.md); more means the states cycle, reported as a failure.
+pub const MAX_ITERATIONS: usize = 200;
+
+/// Halvings of a Newton step in the line search: 12 (the smallest step is 2.4e-4 of the
+/// Newton step; it is taken even if it does not lower the residual, so the iteration cannot
+/// stall at a kink).
+pub const LINE_SEARCH_HALVINGS: usize = 12;
+
+/// A pair that has opened or closed this many times is held closed (it may then carry a
+/// small tension): 4. Why: a pair at the border of the two states (closed with a vanishing
+/// tensile force, open with a vanishing gap; on the coarse dam a few pairs at the joints'
+/// edges) would otherwise flip between them every iteration. Their largest violation is
+/// reported ([`StaticContactInfo::condition_violation`]).
+pub const CHATTER_CHANGES: usize = 4;
+
+/// How the increment was solved.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct StaticContactInfo {
+    /// Newton iterations (one direct solve each).
+    pub iterations: usize,
+    /// Whether ‖R‖/‖F‖ fell below [`TOLERANCE`].
+    pub converged: bool,
+    /// ‖R‖ / ‖F‖ at the end (contact forces included).
+    pub residual: f64,
+    /// Pairs stick, slip, open at the end; pairs left out (a node-to-segment slave node with
+    /// no master face on the initial configuration, even within half a face).
+    pub stick: usize,
+    pub slip: usize,
+    pub open: usize,
+    pub left_out: usize,
+    /// Pairs held closed because they kept opening and closing.
+    pub held: usize,
+    /// Largest penetration −g of a closed pair [m] and the largest |Δu| of the increment [m].
+    pub max_penetration: f64,
+    pub max_displacement: f64,
+    /// Largest normal force of a pair [N].
+    pub max_normal_force: f64,
+    /// Largest tension of a closed pair beyond its tensile strength (only held pairs can have
+    /// one), relative to the largest normal force.
+    pub condition_violation: f64,
+}
+
+impl StaticContactInfo {
+    /// One line.
+    pub fn line(&self) -> String {
+        format!(
+            "{} Newton iterations, residual {:.1e}{}, pairs stick {} / slip {} / open {}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            self.iterations,
+            self.residual,
+            if self.converged { "" } else { " (NOT converged)" },
+            self.stick,
+            self.slip,
+            self.open,
+            if self.left_out > 0 { format!(" / left out {}", self.left_out) } else { String::new() },
+            self.max_penetration,
+            if self.max_displacement > 0.0 { self.max_penetration / self.max_displacement } else { 0.0 },
+            if self.held > 0 { format!(", {} pairs held closed (largest tension {:.1e} of the largest normal force)", self.held, self.condition_violation) } else { String::new() }
+        )
+    }
+}
+
+struct Pair {
+    joint: usize,
+    index: usize,
+    /// w_c as sparse vectors over the reduced unknowns, c = x, y, z.
+    w: [Vec<(usize, f64)>; 3],
+    n: Vector3<f64>,
+    k: f64,
+    area: f64,
+    /// Closed at the last evaluation, and how many times it opened or closed.
+    closed: bool,
+    changes: usize,
+}
+
+/// w (3-vector) of a pair at the reduced solution `uh`.
+fn relative_motion(p: &Pair, uh: &[f64]) -> Vector3<f64> {
+    Vector3::from_fn(|c, _| p.w[c].iter().map(|&(r, v)| v * uh[r]).sum())
+}
+
+/// The law of the module header at w: state, force q on the slave, tangent ∂q/∂w.
+fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, hold_closed: bool) -> (PairState, Vector3<f64>, Matrix3<f64>) {
+    let history = PairHistory::default();
+    let g = p.n.dot(w);
+    let r_n = -p.k * g;
+    if r_n < -law.tensile_strength * p.area && !hold_closed {
+        return (PairState::Open, Vector3::zeros(), Matrix3::zeros());
+    }
+    let wt = w - p.n * g;
+    let limit = law.shear_limit(r_n, &history, p.area);
+    let nn = p.n * p.n.transpose();
+    if p.k * wt.norm() <= limit {
+        (PairState::Stick, w * p.k, Matrix3::identity() * p.k)
+    } else {
+        let t = wt / wt.norm();
+        let ks = limit / wt.norm();
+        // ∂L/∂w = −μ k nᵀ while the limit is above its floor 0
+        let coupling = if limit > 0.0 { t * p.n.transpose() * (-law.mu * p.k) } else { Matrix3::zeros() };
+        (PairState::Slip, p.n * (p.k * g) + t * limit, nn * p.k + (Matrix3::identity() - nn - t * t.transpose()) * ks + coupling)
+    }
+}
+
+/// Solve the increment `f` (forces over every model dof) on `problem`'s model with the tied
+/// joints bonded and the other joints active, from grouted joints (gap 0, no force), with the
+/// penalty `penalty_factor` × the slave node's diagonal stiffness ([`PENALTY_FACTOR`]). Returns
+/// Δu over every model dof and the report, and writes each pair's state, forces and gap into
+/// `contact`.
+pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64) -> Result<(Vec<f64>, StaticContactInfo), Error> {
+    let model = &problem.model;
+    let k_full = stiffness(model, &vec![true; model.materials.len()]);
+    let tied: Vec<&ContactJoint> = problem.joints.iter().filter(|j| j.law.tied).collect();
+    let t = Bonding::build(model, &tied, |d| model.is_free(d / 3, d % 3) && k_full.col_ptr[d + 1] > k_full.col_ptr[d])?;
+    let k0 = t.reduce(&k_full);
+    let f0 = t.reduce_vector(f);
+    let mut info = StaticContactInfo::default();
+    // the pairs
+    let mut pairs = Vec::new();
+    for (ji, j) in problem.joints.iter().enumerate() {
+        if j.law.tied {
+            continue;
+        }
+        for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
+            let masters = match j.method {
+                Method::Ntn => vec![(j.tag.nearest_master_node(i), 1.0)],
+                _ => match master_point(model, j, i)? {
+                    (_, MasterHit::NearestNode) => {
+                        info.left_out += 1;
+                        continue;
+                    }
+                    (m, _) => m,
+                },
+            };
+            let mut w: [Vec<(usize, f64)>; 3] = Default::default();
+            for (c, wc) in w.iter_mut().enumerate() {
+                let mut add = |d: usize, scale: f64| {
+                    for &(r, v) in &t.rows[d] {
+                        match wc.iter_mut().find(|e| e.0 == r) {
+                            Some(e) => e.1 += scale * v,
+                            None => wc.push((r, scale * v)),
+                        }
+                    }
+                };
+                for &(m, nw) in &masters {
+                    add(3 * m + c, nw);
+                }
+                add(3 * s + c, -1.0);
+                wc.retain(|e| e.1 != 0.0);
+            }
+            let diag = (0..3).map(|c| k_full.get(3 * s + c, 3 * s + c)).sum::<f64>() / 3.0;
+            pairs.push(Pair { joint: ji, index: i, w, n: j.frames[i][0], k: penalty_factor * diag, area: j.tag.areas[i], closed: true, changes: 0 });
+        }
+    }
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let nf = norm(&f0);
+    let mut uh = vec![0.0; t.n];
+    // R(u) = F − K u − Σ Bᵀ q into `r`, the contact part of the tangent into `extra` when asked,
+    // and each pair's closed flag
+    let evaluate = |uh: &[f64], pairs: &[Pair], r: &mut Vec<f64>, extra: Option<&mut Vec<(usize, usize, f64)>>, closed: &mut Vec<bool>| {
+        k0.mul_into(uh, r);
+        for (ri, fi) in r.iter_mut().zip(&f0) {
+            *ri = fi - *ri;
+        }
+        closed.clear();
+        let mut extra = extra;
+        for p in pairs {
+            let w = relative_motion(p, uh);
+            let (state, q, tangent) = pair_force(p, &w, &problem.joints[p.joint].law, p.changes >= CHATTER_CHANGES);
+            closed.push(state != PairState::Open);
+            for (c, wc) in p.w.iter().enumerate() {
+                for &(a, va) in wc {
+                    r[a] -= q[c] * va;
+                }
+                if let Some(extra) = extra.as_deref_mut() {
+                    for (d, wd) in p.w.iter().enumerate() {
+                        let kcd = tangent[(c, d)];
+                        if kcd == 0.0 {
+                            continue;
+                        }
+                        for &(a, va) in wc {
+                            for &(b, vb) in wd {
+                                extra.push((a, b, kcd * va * vb));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if nf > 0.0 { norm(r) / nf } else { 0.0 }
+    };
+    let (mut r, mut r_try) = (vec![0.0; t.n], vec![0.0; t.n]);
+    let (mut closed, mut closed_try) = (Vec::new(), Vec::new());
+    let mut extra = Vec::new();
+    let mut u_try = vec![0.0; t.n];
+    for it in 0..=MAX_ITERATIONS {
+        extra.clear();
+        info.residual = evaluate(&uh, &pairs, &mut r, Some(&mut extra), &mut closed);
+        info.iterations = it;
+        for (p, &c) in pairs.iter_mut().zip(&closed) {
+            if c != p.closed {
+                p.changes += 1;
+                p.closed = c;
+            }
+        }
+        if info.residual < TOLERANCE || it == MAX_ITERATIONS {
+            info.converged = info.residual < TOLERANCE;
+            break;
+        }
+        let kt = add_entries(&k0, &extra);
+        lu_solve_in_place(&kt, &mut r, "static stage with the joints active").map_err(|e| ModelError::Invalid(e.to_string()))?;
+        // backtracking line search on ‖R‖ (Armijo, halving): the law is only piecewise smooth
+        let mut step = 1.0;
+        for _ in 0..LINE_SEARCH_HALVINGS {
+            for ((ut, u), d) in u_try.iter_mut().zip(&uh).zip(&r) {
+                *ut = u + step * d;
+            }
+            let res = evaluate(&u_try, &pairs, &mut r_try, None, &mut closed_try);
+            if res <= (1.0 - 1e-4 * step) * info.residual {
+                break;
+            }
+            step *= 0.5;
+        }
+        uh.copy_from_slice(&u_try);
+    }
+    // the result and the pairs' records
+    let mut du = vec![0.0; t.n_dofs];
+    t.expand_into(&uh, &mut du);
+    info.max_displacement = (0..model.n_nodes()).map(|n| Vector3::new(du[3 * n], du[3 * n + 1], du[3 * n + 2]).norm()).fold(0.0, f64::max);
+    let mut tension = 0.0f64;
+    for p in &pairs {
+        let w = relative_motion(p, &uh);
+        let j = &problem.joints[p.joint];
+        let held = p.changes >= CHATTER_CHANGES;
+        let (state, q, _) = pair_force(p, &w, &j.law, held);
+        let g = p.n.dot(&w);
+        let r_n = -p.k * g;
+        let [_, t1, t2] = j.frames[p.index];
+        let rec = &mut contact.joints[p.joint].pairs[p.index];
+        rec.gap = g;
+        rec.state = state;
+        match state {
+            PairState::Open => info.open += 1,
+            PairState::Slip => info.slip += 1,
+            _ => info.stick += 1,
+        }
+        if held {
+            info.held += 1;
+        }
+        if state != PairState::Open {
+            info.max_penetration = info.max_penetration.max(-g);
+            info.max_normal_force = info.max_normal_force.max(r_n);
+            tension = tension.max(-r_n - j.law.tensile_strength * p.area);
+        }
+        let qt = q - p.n * p.n.dot(&q);
+        rec.r_n = if state == PairState::Open { 0.0 } else { r_n };
+        rec.r_t = [qt.dot(&t1), qt.dot(&t2)];
+        if state != PairState::Stick && !j.law.keep_cohesion {
+            rec.hist.intact = false;
+        }
+    }
+    info.condition_violation = if info.max_normal_force > 0.0 { tension.max(0.0) / info.max_normal_force } else { 0.0 };
+    Ok((du, info))
+}
