@@ -42,6 +42,9 @@ pub struct ReservoirSpec {
     pub bottom: f64,
     /// Acceleration of gravity [m/s²].
     pub g: f64,
+    /// Added mass with the **local** depth H_a at each wet node instead of the depth H at the
+    /// dam (see [`added_masses`]). Default false (Kuo's generalised Westergaard uses H).
+    pub local_depth: bool,
 }
 
 impl ReservoirSpec {
@@ -193,6 +196,13 @@ impl AddedMass {
 }
 
 /// Westergaard/Kuo added mass of every wet node below the pool level, by node index.
+///
+/// With `spec.local_depth` the depth H in m_a = (7/8) ρw √(H (z_w − z_a)) A_a is the local
+/// depth H_a = z_w − z_heel at the node's own section instead of the depth at the dam: z_heel is
+/// the elevation of the nearest node in plan (horizontal distance) of the wet surface's lower
+/// boundary (its boundary edges' nodes below the pool: on a dam the line where the upstream face
+/// meets the rock), the lowest of them where several share that plan distance (a vertical edge). On a vertical wall over a flat bottom H_a = H (the same masses); on an arch
+/// dam's bank sections, where the water above the rock is shallower, it is smaller.
 pub fn added_masses(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Vec<AddedMass> {
     let mut acc: std::collections::BTreeMap<usize, (f64, Vector3<f64>)> = Default::default();
     for f in faces {
@@ -205,7 +215,20 @@ pub fn added_masses(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Vec
             }
         }
     }
-    let h = spec.depth();
+    let heel = if spec.local_depth { lower_boundary_nodes(faces, mesh, spec.level) } else { Vec::new() };
+    let depth_at = |node: usize| -> f64 {
+        if heel.is_empty() {
+            return spec.depth();
+        }
+        let x = mesh.nodes[node];
+        let plan = |b: usize| (mesh.nodes[b][0] - x[0]).powi(2) + (mesh.nodes[b][1] - x[1]).powi(2);
+        // the nearest in plan, and of the nodes equally near (a vertical edge of the face: one
+        // plan position) the lowest, the foot of that section
+        let d_min = heel.iter().map(|&b| plan(b).sqrt()).fold(f64::INFINITY, f64::min);
+        let tie = d_min + 1e-6 * spec.depth().abs();
+        let z_heel = heel.iter().filter(|&&b| plan(b).sqrt() <= tie).map(|&b| mesh.nodes[b][2]).fold(f64::INFINITY, f64::min);
+        (spec.level - z_heel).max(spec.level - x[2])
+    };
     acc.into_iter()
         .filter_map(|(node, (area, nsum))| {
             let depth = spec.level - mesh.nodes[node][2];
@@ -213,10 +236,26 @@ pub fn added_masses(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Vec
                 return None;
             }
             let n = nsum.normalize();
-            let mass = 0.875 * spec.rho_w * (h * depth).sqrt() * area;
+            let mass = 0.875 * spec.rho_w * (depth_at(node) * depth).sqrt() * area;
             Some(AddedMass { node, mass, normal: [n[0], n[1], n[2]], area })
         })
         .collect()
+}
+
+/// The nodes of the wet surface's boundary edges (edges of one wet face only) below `level`.
+fn lower_boundary_nodes(faces: &[WetFace], mesh: &Mesh, level: f64) -> Vec<usize> {
+    let mut count: std::collections::HashMap<(usize, usize), usize> = Default::default();
+    for f in faces {
+        let k = f.nodes.len();
+        for e in 0..k {
+            let (a, b) = (f.nodes[e], f.nodes[(e + 1) % k]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    let mut nodes: Vec<usize> = count.into_iter().filter(|(_, c)| *c == 1).flat_map(|((a, b), _)| [a, b]).filter(|&n| mesh.nodes[n][2] < level).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
 }
 
 #[cfg(test)]
@@ -240,7 +279,7 @@ mod tests {
         for tets in [false, true] {
             for (level, tol) in [(10.0, 1e-9), (7.0, 1e-5)] {
                 let (mesh, faces) = wall(8, tets);
-                let spec = ReservoirSpec { rho_w: 1000.0, level, bottom: 0.0, g: 9.81 };
+                let spec = ReservoirSpec { rho_w: 1000.0, level, bottom: 0.0, g: 9.81, local_depth: false };
                 let f = hydrostatic_forces(&mesh, &faces, &spec);
                 let (mut fx, mut fy, mut fz, mut mz) = (0.0, 0.0, 0.0, 0.0);
                 for &(n, v) in &f {
@@ -260,12 +299,30 @@ mod tests {
     }
 
     #[test]
+    fn local_depth_added_mass_equals_the_dam_depth_one_on_a_wall_over_a_flat_bottom() {
+        // Reference: on a vertical wall over a flat bottom every node's section is as deep as
+        // the reservoir, so the local-depth rule gives the same masses to round-off (1e-12),
+        // including the nodes on the face's vertical side edges (a boundary of the wet face
+        // whose nodes share the plan position of the bottom corner).
+        for tets in [false, true] {
+            let (mesh, faces) = wall(10, tets);
+            let spec = ReservoirSpec { rho_w: 1000.0, level: 10.0, bottom: 0.0, g: 9.81, local_depth: false };
+            let global = added_masses(&mesh, &faces, &spec);
+            let local = added_masses(&mesh, &faces, &ReservoirSpec { local_depth: true, ..spec });
+            assert_eq!(global.len(), local.len());
+            for (a, b) in global.iter().zip(&local) {
+                assert!((a.mass - b.mass).abs() <= 1e-12 * a.mass, "node {}: {} vs {}", a.node, a.mass, b.mass);
+            }
+        }
+    }
+
+    #[test]
     fn westergaard_total_on_a_rigid_vertical_wall() {
         // Reference: Σ m_a = (7/12) ρw H² b for a vertical wall (Westergaard 1933); the nodal
         // sum of √ converges as h^1.5: within 1 % at 10 nodes over H, 0.4 % at 20
         for (nz, tol) in [(10, 0.01), (20, 0.004)] {
             let (mesh, faces) = wall(nz, false);
-            let spec = ReservoirSpec { rho_w: 1000.0, level: 10.0, bottom: 0.0, g: 9.81 };
+            let spec = ReservoirSpec { rho_w: 1000.0, level: 10.0, bottom: 0.0, g: 9.81, local_depth: false };
             let m = added_masses(&mesh, &faces, &spec);
             let total: f64 = m.iter().map(|a| a.mass).sum();
             let exact = 7.0 / 12.0 * 1000.0 * 100.0 * 3.0;
@@ -297,7 +354,7 @@ mod tests {
                 faces.push(WetFace { kind: CellKind::Quad4, nodes: vec![id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)] });
             }
         }
-        let spec = ReservoirSpec { rho_w: 1000.0, level: hgt, bottom: 0.0, g: 9.81 };
+        let spec = ReservoirSpec { rho_w: 1000.0, level: hgt, bottom: 0.0, g: 9.81, local_depth: false };
         let m = added_masses(&mesh, &faces, &spec);
         assert!(!m.is_empty());
         for a in &m {

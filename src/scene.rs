@@ -64,6 +64,16 @@ pub struct ReservoirScene {
     /// Westergaard/Kuo added mass along the face normal (inertia, not weight). Default true.
     #[serde(default = "yes")]
     pub added_mass: bool,
+    /// The depth H in the added mass (7/8) ρw √(H (z_w − z)): `"reservoir"` (default: the depth
+    /// at the dam, Kuo's generalised Westergaard as usually applied) or `"local"` (the depth of
+    /// the node's own section, above the nearest point of the face's foot: smaller on an arch
+    /// dam's banks; docs/dam.md, "Modes").
+    #[serde(default = "default_added_mass_depth")]
+    pub added_mass_depth: String,
+}
+
+fn default_added_mass_depth() -> String {
+    "reservoir".into()
 }
 
 fn default_rho_w() -> f64 {
@@ -976,6 +986,9 @@ impl Scene {
             }
             if !(r.rho_w > 0.0 && r.rho_w.is_finite()) {
                 return Err(format!("reservoir.rho_w = {} must be positive [kg/m³]", r.rho_w));
+            }
+            if !matches!(r.added_mass_depth.as_str(), "reservoir" | "local") {
+                return Err(format!("reservoir.added_mass_depth \"{}\" is not \"reservoir\" (the depth at the dam) or \"local\" (the depth of the node's section)", r.added_mass_depth));
             }
             if !r.level.is_finite() {
                 return Err("reservoir.level must be a finite height [m]".into());
