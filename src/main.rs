@@ -176,7 +176,7 @@ enum Cmd {
         /// patch (uniform pressure/shear through the joint, static), slide (block on an
         /// incline), newmark (the block under a base record against rigid Newmark), impact (two bars).
         kind: String,
-        /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2.
+        /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2, mixed:4 (ELEMENT hex8, tet4 or mixed).
         #[arg(long)]
         lower: Option<String>,
         /// Upper side ELEMENT:N[:LAYERS].

@@ -16,8 +16,9 @@
 //! - **Groups** (from `mesh::structured`): `block:lower`, `block:upper`; faces `lower:z1` and
 //!   `upper:z0` are the two sides of joint `J`; `lower:z0` is fixed (base); the other faces
 //!   `<block>:x0 … z1` carry the tractions of the exact state.
-//! - **Sides**: `ELEMENT:N[:LAYERS]`, e.g. `hex8:4`, `tet4:3:2`: hex8 or tet4 (each grid cell
-//!   split into 6 tets, Kuhn), N divisions per unit length in x and y, LAYERS element layers
+//! - **Sides**: `ELEMENT:N[:LAYERS]`, e.g. `hex8:4`, `tet4:3:2`, `mixed:4`: hex8, tet4 (each grid
+//!   cell split into 6 tets, Kuhn) or mixed (hex8 in the first ⌈N/2⌉ columns along x, tet4 in the
+//!   rest: the joint face is half quads, half triangles; `mesh::structured`), N divisions per unit length in x and y, LAYERS element layers
 //!   through the block (default 2).
 //! - **Slave**: the side whose nodes are paired (`lower` or `upper`); default the finer side
 //!   (more in-plane divisions; `upper` on a tie), the tagger's own rule.
@@ -80,6 +81,9 @@ impl std::str::FromStr for Kind {
 pub enum Element {
     Hex8,
     Tet4,
+    /// Hex8 in the first ⌈N/2⌉ columns along x, tet4 (Kuhn split) in the rest
+    /// (`mesh::structured`), so the joint face is half quads, half triangles.
+    Mixed,
 }
 
 /// One side's mesh: `ELEMENT:N[:LAYERS]` (see the module conventions).
@@ -96,13 +100,14 @@ impl std::str::FromStr for SideSpec {
     type Err = String;
     fn from_str(s: &str) -> Result<SideSpec, String> {
         let parts: Vec<&str> = s.split(':').collect();
-        let bad = || format!("\"{s}\": write ELEMENT:N[:LAYERS], e.g. hex8:4 or tet4:3:2 (ELEMENT hex8 or tet4, N and LAYERS whole numbers from 1 to 200)");
+        let bad = || format!("\"{s}\": write ELEMENT:N[:LAYERS], e.g. hex8:4 or tet4:3:2 (ELEMENT hex8, tet4 or mixed, N and LAYERS whole numbers from 1 to 200)");
         if parts.len() < 2 || parts.len() > 3 {
             return Err(bad());
         }
         let element = match parts[0] {
             "hex8" => Element::Hex8,
             "tet4" => Element::Tet4,
+            "mixed" => Element::Mixed,
             _ => return Err(bad()),
         };
         let num = |t: &str| t.parse::<usize>().ok().filter(|&v| (1..=200).contains(&v)).ok_or_else(bad);
@@ -117,6 +122,7 @@ impl std::fmt::Display for SideSpec {
         let e = match self.element {
             Element::Hex8 => "hex8",
             Element::Tet4 => "tet4",
+            Element::Mixed => "mixed",
         };
         write!(f, "{e}:{}:{}", self.n, self.layers)
     }
@@ -346,7 +352,7 @@ impl CaseSpec {
             return Err(invalid("massless_lower", "NTN on a massless side is not a supported combination; use nts"));
         }
         // size of the problem: refuse what would not fit in memory before allocating it
-        let cells = |s: &SideSpec, len: usize| s.n * s.n * len * s.layers * if s.element == Element::Tet4 { 6 } else { 1 };
+        let cells = |s: &SideSpec, len: usize| s.n * s.n * len * s.layers * if s.element == Element::Hex8 { 1 } else { 6 };
         let total = cells(&lower, if matches!(k, Kind::Slide | Kind::Newmark) { 4 } else { 1 }) + cells(&upper, 1);
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
@@ -432,7 +438,7 @@ pub fn build(spec: &CaseSpec) -> Result<Case, Error> {
 fn side_box(name: &str, side: &SideSpec, size: [f64; 3], origin: [f64; 3], along: [f64; 2]) -> BoxSpec {
     let nx = ((side.n as f64 * along[0]).round() as usize).max(1);
     let ny = ((side.n as f64 * along[1]).round() as usize).max(1);
-    BoxSpec::new(name, size, [nx, ny, side.layers]).at(origin).tets(side.element == Element::Tet4)
+    BoxSpec::new(name, size, [nx, ny, side.layers]).at(origin).tets(side.element == Element::Tet4).mixed(side.element == Element::Mixed)
 }
 
 /// The two blocks in the local frame, rotated by R.
@@ -453,8 +459,8 @@ pub fn case_mesh(r: &Resolved) -> Mesh {
             let a = BAR_A;
             let bar = |s: &SideSpec| [s.n, s.n, s.layers];
             let (lo, up) = (r.lower, r.upper);
-            add_box(&mut mesh, &BoxSpec::new("lower", [a, a, BAR_L], bar(&lo)).at([0.0, 0.0, -BAR_L]).tets(lo.element == Element::Tet4));
-            add_box(&mut mesh, &BoxSpec::new("upper", [a, a, BAR_L], bar(&up)).tets(up.element == Element::Tet4));
+            add_box(&mut mesh, &BoxSpec::new("lower", [a, a, BAR_L], bar(&lo)).at([0.0, 0.0, -BAR_L]).tets(lo.element == Element::Tet4).mixed(lo.element == Element::Mixed));
+            add_box(&mut mesh, &BoxSpec::new("upper", [a, a, BAR_L], bar(&up)).tets(up.element == Element::Tet4).mixed(up.element == Element::Mixed));
         }
     }
     let rot = r.rotation();
