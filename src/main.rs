@@ -227,6 +227,14 @@ enum Cmd {
         /// The joint's edge_tolerance (fraction of the master face size).
         #[arg(long)]
         edge_tolerance: Option<f64>,
+        /// Shift of the upper side's interior grid lines in the joint plane, as a fraction of
+        /// its element (|s| < 1).
+        #[arg(long, allow_negative_numbers = true)]
+        offset: Option<f64>,
+        /// Turn of the upper side's mesh about the joint normal [deg] (inner half rigid, blended
+        /// to 0 at the outline; |θ| ≤ 45).
+        #[arg(long, allow_negative_numbers = true)]
+        rotate: Option<f64>,
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
@@ -607,10 +615,12 @@ fn real_main() -> Result<()> {
         }
         Cmd::Study { action } => study_cmd(action)?,
         Cmd::Record { action } => record_cmd(action)?,
-        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, record, pga, out, run, json } => {
+        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, offset, rotate, record, pga, out, run, json } => {
             // the options as the study file writes a case (one parser and one set of checks)
             let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
-            let opts: [(&str, serde_json::Value); 15] = [
+            let opts: [(&str, serde_json::Value); 17] = [
+                ("offset", offset.into()),
+                ("rotate", rotate.into()),
                 ("record", record.map(|p| p.display().to_string()).into()),
                 ("pga", pga.into()),
                 ("edge_tolerance", edge_tolerance.into()),

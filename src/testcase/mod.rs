@@ -216,6 +216,18 @@ pub struct CaseSpec {
     /// master by dt² F/m; above this tolerance it is lost (docs/validation.md §8).
     #[serde(default)]
     pub edge_tolerance: Option<f64>,
+    /// Shift of the upper side's mesh in the joint plane, as a fraction s of its element size h:
+    /// its interior grid lines (x and y) move by s·h, its outline stays (the joint is the same
+    /// rectangle on both sides, which the exact references need), so its first row of elements
+    /// is (1 + s) h wide and its last (1 − s) h. |s| < 1; needs N ≥ 2. Default 0.
+    #[serde(default)]
+    pub offset: Option<f64>,
+    /// Turn of the upper side's mesh about the joint normal [deg]: every node at "square radius"
+    /// ρ = max(|x − x_c|/(l_x/2), |y − y_c|/(l_y/2)) from the joint's centre turns by θ·w(ρ), w = 1
+    /// for ρ ≤ ½ (the inner half is the grid rigidly turned by θ) and 2 (1 − ρ) beyond, so the
+    /// outline stays. |θ| ≤ 45; an element turned inside out is refused. Default 0.
+    #[serde(default)]
+    pub rotate: Option<f64>,
 }
 
 /// Patch material and geometry (module conventions).
@@ -255,6 +267,11 @@ pub struct Resolved {
     pub duration: f64,
     pub residual: f64,
     pub edge_tolerance: Option<f64>,
+    /// Upper side's in-plane shift (fraction of its element) and turn [deg] (see [`CaseSpec`]).
+    #[serde(default)]
+    pub offset: f64,
+    #[serde(default)]
+    pub rotate: f64,
     /// Newmark: the record (absolute path) and its PGA [g].
     pub record: Option<PathBuf>,
     pub pga: f64,
@@ -348,6 +365,17 @@ impl CaseSpec {
         if let Some(e) = self.edge_tolerance.filter(|e| !(e.is_finite() && *e > 0.0 && *e < 1.0)) {
             return Err(invalid("edge_tolerance", format!("{e}: give a fraction of the face size in (0, 1)")));
         }
+        let offset = self.offset.unwrap_or(0.0);
+        if !(offset.is_finite() && offset.abs() < 1.0) {
+            return Err(invalid("offset", format!("{offset}: give a fraction of the upper side's element with |s| < 1 (0.3: its interior grid lines move by 0.3 h)")));
+        }
+        if offset != 0.0 && upper.n < 2 {
+            return Err(invalid("offset", format!("the upper side {upper} has no interior grid line to shift: give N ≥ 2")));
+        }
+        let rotate = self.rotate.unwrap_or(0.0);
+        if !(rotate.is_finite() && rotate.abs() <= 45.0) {
+            return Err(invalid("rotate", format!("{rotate}: give |θ| ≤ 45 deg")));
+        }
         if self.massless_lower && slave == Side::Lower && !self.tied && method == ContactMethod::Ntn {
             return Err(invalid("massless_lower", "NTN on a massless side is not a supported combination; use nts"));
         }
@@ -357,7 +385,7 @@ impl CaseSpec {
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
-        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, record, pga })
+        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, record, pga })
     }
 }
 
@@ -395,7 +423,14 @@ impl Resolved {
     /// A short label: `patch hex8:4:2/hex8:3:2 slave lower nts`.
     pub fn label(&self) -> String {
         let m = if self.tied { format!("{} tied", self.method.as_str()) } else { self.method.as_str().to_string() };
-        format!("{:?} {}/{} slave {:?} {m}", self.kind, self.lower, self.upper, self.slave).to_lowercase()
+        let mut l = format!("{:?} {}/{} slave {:?} {m}", self.kind, self.lower, self.upper, self.slave).to_lowercase();
+        if self.offset != 0.0 {
+            l += &format!(" offset {}", self.offset);
+        }
+        if self.rotate != 0.0 {
+            l += &format!(" rotate {}", self.rotate);
+        }
+        l
     }
 }
 
@@ -426,7 +461,7 @@ pub struct Case {
 /// Build the case of `spec`.
 pub fn build(spec: &CaseSpec) -> Result<Case, Error> {
     let r = spec.resolved()?;
-    let mesh = case_mesh(&r);
+    let mesh = case_mesh(&r)?;
     let scene = case_scene(&r);
     let reference = match r.kind {
         Kind::Newmark => newmark_reference(&r, &scene)?,
@@ -441,26 +476,46 @@ fn side_box(name: &str, side: &SideSpec, size: [f64; 3], origin: [f64; 3], along
     BoxSpec::new(name, size, [nx, ny, side.layers]).at(origin).tets(side.element == Element::Tet4).mixed(side.element == Element::Mixed)
 }
 
-/// The two blocks in the local frame, rotated by R.
-pub fn case_mesh(r: &Resolved) -> Mesh {
+/// The two blocks in the local frame, the upper side's mesh shifted and turned in the joint
+/// plane (`offset`, `rotate`), the whole rotated by R. An element turned inside out by the turn
+/// is an error naming `rotate`.
+pub fn case_mesh(r: &Resolved) -> Result<Mesh, Error> {
     let mut mesh = Mesh { source: PathBuf::from(format!("<testcase {}>", r.label())), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
-    match r.kind {
+    // the upper box and its footprint in the joint plane (origin, size)
+    let upper = match r.kind {
         Kind::Patch => {
             let (a, h) = (PATCH_SIDE, PATCH_HEIGHT);
             add_box(&mut mesh, &side_box("lower", &r.lower, [a, a, h], [0.0, 0.0, -h], [1.0, 1.0]));
-            add_box(&mut mesh, &side_box("upper", &r.upper, [a, a, h], [0.0, 0.0, 0.0], [1.0, 1.0]));
+            side_box("upper", &r.upper, [a, a, h], [0.0, 0.0, 0.0], [1.0, 1.0])
         }
         Kind::Slide | Kind::Newmark => {
             // base 4 × 1 × 0.5 m from x = −0.5; slider 1 × 0.5 × 0.5 m at x ∈ [2, 3], y ∈ [0.25, 0.75]
             add_box(&mut mesh, &side_box("lower", &r.lower, [4.0, 1.0, 0.5], [-0.5, 0.0, -0.5], [4.0, 1.0]));
-            add_box(&mut mesh, &side_box("upper", &r.upper, [1.0, 0.5, 0.5], [2.0, 0.25, 0.0], [1.0, 0.5]));
+            side_box("upper", &r.upper, [1.0, 0.5, 0.5], [2.0, 0.25, 0.0], [1.0, 0.5])
         }
         Kind::Impact => {
             let a = BAR_A;
             let bar = |s: &SideSpec| [s.n, s.n, s.layers];
             let (lo, up) = (r.lower, r.upper);
             add_box(&mut mesh, &BoxSpec::new("lower", [a, a, BAR_L], bar(&lo)).at([0.0, 0.0, -BAR_L]).tets(lo.element == Element::Tet4).mixed(lo.element == Element::Mixed));
-            add_box(&mut mesh, &BoxSpec::new("upper", [a, a, BAR_L], bar(&up)).tets(up.element == Element::Tet4).mixed(up.element == Element::Mixed));
+            BoxSpec::new("upper", [a, a, BAR_L], bar(&up)).tets(up.element == Element::Tet4).mixed(up.element == Element::Mixed)
+        }
+    };
+    let first_upper = mesh.nodes.len();
+    add_box(&mut mesh, &upper);
+    if r.offset != 0.0 || r.rotate != 0.0 {
+        for x in &mut mesh.nodes[first_upper..] {
+            let (px, py) = shift_and_turn(&upper, r.offset, r.rotate, x[0], x[1]);
+            x[0] = px;
+            x[1] = py;
+        }
+        let cells = &mesh.group("block:upper").expect("the upper block's group").cells;
+        if let Some(&c) = cells.iter().find(|&&c| !(mesh.min_corner_jacobian(c) > 0.0)) {
+            let x = mesh.cells[c].nodes().iter().map(|&n| mesh.x(n as usize)).sum::<Vector3<f64>>() / mesh.cells[c].nodes().len() as f64;
+            return Err(invalid(
+                "rotate",
+                format!("θ = {} deg with offset {} turns the upper element at ({:.3}, {:.3}, {:.3}) inside out; use a smaller turn or a coarser upper side", r.rotate, r.offset, x[0], x[1], x[2]),
+            ));
         }
     }
     let rot = r.rotation();
@@ -470,7 +525,25 @@ pub fn case_mesh(r: &Resolved) -> Mesh {
             *x = [y[0], y[1], y[2]];
         }
     }
-    mesh
+    Ok(mesh)
+}
+
+/// The in-plane map of `offset` and `rotate` (see [`CaseSpec`]) for the box `b`: interior grid
+/// lines moved by s·h, then the turn θ·w(ρ) about the footprint's centre.
+fn shift_and_turn(b: &BoxSpec, s: f64, theta_deg: f64, x: f64, y: f64) -> (f64, f64) {
+    let (o, l, n) = (b.origin, b.size, b.divisions);
+    let tol = 1e-9 * l[0].max(l[1]);
+    let shift = |v: f64, axis: usize| {
+        let h = l[axis] / n[axis] as f64;
+        if v > o[axis] + tol && v < o[axis] + l[axis] - tol { v + s * h } else { v }
+    };
+    let (x, y) = (shift(x, 0), shift(y, 1));
+    let (cx, cy) = (o[0] + 0.5 * l[0], o[1] + 0.5 * l[1]);
+    let (dx, dy) = (x - cx, y - cy);
+    let rho = (dx.abs() / (0.5 * l[0])).max(dy.abs() / (0.5 * l[1]));
+    let w = if rho <= 0.5 { 1.0 } else { (2.0 * (1.0 - rho)).max(0.0) };
+    let (sn, cs) = (theta_deg.to_radians() * w).sin_cos();
+    (cx + cs * dx - sn * dy, cy + sn * dx + cs * dy)
 }
 
 /// The exact local stress of the patch (xx, yy, zz, xy, yz, zx).
@@ -640,4 +713,28 @@ pub fn write_case(case: &Case, dir: &Path) -> Result<CaseFiles, Error> {
     let refj = json!({"case": case.spec, "reference": case.reference});
     std::fs::write(&reference, serde_json::to_string_pretty(&refj).expect("a reference serialises")).map_err(|e| w(&reference, e))?;
     Ok(CaseFiles { msh, scene, reference })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The in-plane map keeps the outline and moves the inside: interior grid lines by s·h, the
+    /// inner half turned rigidly by θ about the centre (reference: the definitions on `CaseSpec`).
+    #[test]
+    fn shift_and_turn_keeps_the_outline_and_turns_the_inner_half() {
+        let b = BoxSpec::new("upper", [1.0, 1.0, 0.5], [4, 4, 2]);
+        // outline points stay, interior lines move by 0.3 × 0.25
+        for (x, y) in [(0.0, 0.0), (1.0, 0.25), (0.5, 1.0), (0.0, 0.75)] {
+            let (px, py) = shift_and_turn(&b, 0.3, 15.0, x, y);
+            let moved_along = |v: f64, p: f64| if v > 0.0 && v < 1.0 { p - v - 0.075 } else { p - v };
+            // on the outline (ρ = 1) the turn is 0 and only the interior coordinate shifts
+            assert!(moved_along(x, px).abs() < 1e-12 && moved_along(y, py).abs() < 1e-12, "({x}, {y}) -> ({px}, {py})");
+        }
+        // (0.5, 0.25) is on an interior line in y: shifted to (0.575, 0.325), ρ = 0.35 ≤ ½: turned by θ
+        let (px, py) = shift_and_turn(&b, 0.3, 15.0, 0.5, 0.25);
+        let (dx, dy) = (0.075, -0.175);
+        let (sn, cs) = 15f64.to_radians().sin_cos();
+        assert!((px - (0.5 + cs * dx - sn * dy)).abs() < 1e-12 && (py - (0.5 + sn * dx + cs * dy)).abs() < 1e-12);
+    }
 }
