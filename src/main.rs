@@ -235,6 +235,10 @@ enum Cmd {
         /// to 0 at the outline; |θ| ≤ 45).
         #[arg(long, allow_negative_numbers = true)]
         rotate: Option<f64>,
+        /// Patch: a cylindrical joint of radius R [m] (axis along y; R > 0 the lower block
+        /// bulges up, R < 0 a trough; |R| > 0.5); μ must exceed the steepest slope.
+        #[arg(long, allow_negative_numbers = true)]
+        curvature: Option<f64>,
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
@@ -615,10 +619,11 @@ fn real_main() -> Result<()> {
         }
         Cmd::Study { action } => study_cmd(action)?,
         Cmd::Record { action } => record_cmd(action)?,
-        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, offset, rotate, record, pga, out, run, json } => {
+        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, offset, rotate, curvature, record, pga, out, run, json } => {
             // the options as the study file writes a case (one parser and one set of checks)
             let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
-            let opts: [(&str, serde_json::Value); 17] = [
+            let opts: [(&str, serde_json::Value); 18] = [
+                ("curvature", curvature.into()),
                 ("offset", offset.into()),
                 ("rotate", rotate.into()),
                 ("record", record.map(|p| p.display().to_string()).into()),

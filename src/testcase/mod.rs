@@ -30,6 +30,15 @@
 //!   as the tractions σ·n of that state on every free face. Exact: that stress in every
 //!   element, contact pressure p and shear traction τ at every slave node (r = p A_s). Solved
 //!   statically (dynamic relaxation with adaptive critical damping, [`run`]).
+//!   With `curvature` R the joint is a cylinder (axis along y, [`CaseSpec::curvature`]) under
+//!   the same pressure state σzz = −p: it is exactly linear (u = −(p/E)(z + H) e_z), so a
+//!   conforming mesh reproduces it to round-off whatever the joint's shape, and on the cylinder it
+//!   is the traction σ n = −p n_z e_z, normal p n_z² and shear p n_z |n_x| (stick needs μ above the
+//!   steepest slope, tan α = ½ / √(R² − ¼)); the exact force at a slave node is σ · Σ_f n_f ∫ N_I dA.
+//!   (A Lamé solution of concentric cylinders under radial pressure would mix the elements' own
+//!   error into the contact's, and needs rollers on joint nodes, which the contact force treats as
+//!   fixed nodes (`contact::force`, inverse mass 0 for any fixed component); this state keeps the
+//!   patch test's property that any error is the joint's.)
 //! - `slide`: a 1 × 0.5 × 0.5 m block on a 4 × 1 × 0.5 m base inclined at β, μ < tan β, gravity
 //!   from rest: s(t) = ½ g (sin β − μ cos β) t² down the slope (refs/analytic.py B).
 //! - `newmark`: the `slide` geometry with μ ≥ tan β (the block holds under gravity), gravity
@@ -228,6 +237,15 @@ pub struct CaseSpec {
     /// outline stays. |θ| ≤ 45; an element turned inside out is refused. Default 0.
     #[serde(default)]
     pub rotate: Option<f64>,
+    /// Patch: a cylindrical joint of radius R [m], axis along local y through the joint's edges
+    /// x = 0 and x = 1 m: z = f(x) = sgn R (√(R² − (x − ½)²) − √(R² − ¼)) (R > 0: the lower block
+    /// bulges into the upper one; R < 0: a trough). The master side's joint nodes lie on the
+    /// cylinder, the slave side's on the master's facets (the initial gap is zero, as CalculiX and
+    /// Abaqus adjust slave nodes); every node column is moved by f(1 − |z|/H). The pressure state
+    /// σzz = −p is unchanged (module doc); μ must exceed the steepest slope ½/√(R² − ¼) unless
+    /// tied. |R| > 0.5 m; default flat.
+    #[serde(default)]
+    pub curvature: Option<f64>,
 }
 
 /// Patch material and geometry (module conventions).
@@ -272,6 +290,9 @@ pub struct Resolved {
     pub offset: f64,
     #[serde(default)]
     pub rotate: f64,
+    /// Patch: radius of the cylindrical joint [m] (see [`CaseSpec`]); None: flat.
+    #[serde(default)]
+    pub curvature: Option<f64>,
     /// Newmark: the record (absolute path) and its PGA [g].
     pub record: Option<PathBuf>,
     pub pga: f64,
@@ -376,6 +397,25 @@ impl CaseSpec {
         if !(rotate.is_finite() && rotate.abs() <= 45.0) {
             return Err(invalid("rotate", format!("{rotate}: give |θ| ≤ 45 deg")));
         }
+        if let Some(rc) = self.curvature {
+            if k != Kind::Patch {
+                return Err(invalid("curvature", "only the patch kind has a cylindrical joint"));
+            }
+            if !(rc.is_finite() && rc.abs() > 0.5 * PATCH_SIDE) {
+                return Err(invalid("curvature", format!("R = {rc}: give |R| > {} m (the joint's half-width)", 0.5 * PATCH_SIDE)));
+            }
+            if shear != 0.0 || rotate != 0.0 || self.massless_lower {
+                return Err(invalid("curvature", "a cylindrical joint takes the pressure state only: no shear, rotate or massless_lower"));
+            }
+            if pressure == 0.0 {
+                return Err(invalid("curvature", "give a pressure p > 0"));
+            }
+            let c = 0.5 * PATCH_SIDE;
+            let slope = c / (rc * rc - c * c).sqrt();
+            if !self.tied && mu <= slope {
+                return Err(invalid("curvature", format!("R = {rc}: the joint's steepest slope tan α = {slope:.4} ≥ μ = {mu}: the blocks would slide (no static solution); raise μ, |R|, or use tied")));
+            }
+        }
         if self.massless_lower && slave == Side::Lower && !self.tied && method == ContactMethod::Ntn {
             return Err(invalid("massless_lower", "NTN on a massless side is not a supported combination; use nts"));
         }
@@ -385,7 +425,7 @@ impl CaseSpec {
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
-        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, record, pga })
+        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, record, pga })
     }
 }
 
@@ -394,6 +434,17 @@ impl Resolved {
     pub fn rotation(&self) -> Matrix3<f64> {
         let (s, c) = self.inclination.to_radians().sin_cos();
         Matrix3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
+    }
+
+    /// Height of the exact joint surface above the local plane z = 0 at local x [m] (0 when flat).
+    pub fn joint_height(&self, x: f64) -> f64 {
+        match self.curvature {
+            Some(rc) => {
+                let c = 0.5 * PATCH_SIDE;
+                rc.signum() * ((rc * rc - (x - c) * (x - c)).max(0.0).sqrt() - (rc * rc - c * c).sqrt())
+            }
+            None => 0.0,
+        }
     }
 
     /// The slave's and master's face groups.
@@ -429,6 +480,9 @@ impl Resolved {
         }
         if self.rotate != 0.0 {
             l += &format!(" rotate {}", self.rotate);
+        }
+        if let Some(rc) = self.curvature {
+            l += &format!(" cylinder R {rc}");
         }
         l
     }
@@ -518,6 +572,9 @@ pub fn case_mesh(r: &Resolved) -> Result<Mesh, Error> {
             ));
         }
     }
+    if r.curvature.is_some() {
+        curve_joint(r, &mut mesh, first_upper)?;
+    }
     let rot = r.rotation();
     if r.inclination != 0.0 {
         for x in mesh.nodes.iter_mut() {
@@ -526,6 +583,42 @@ pub fn case_mesh(r: &Resolved) -> Result<Mesh, Error> {
         }
     }
     Ok(mesh)
+}
+
+/// Bend the patch's joint into the cylinder of `curvature`: master nodes by f(x) (1 − |z|/H),
+/// slave nodes by g(x) (1 − |z|/H) with g the piecewise-linear interpolant of f at the master's
+/// joint node abscissae, so the slave's joint nodes lie on the master's facets (zero initial
+/// gap). Nodes `first_upper..` are the upper block's.
+fn curve_joint(r: &Resolved, mesh: &mut Mesh, first_upper: usize) -> Result<(), Error> {
+    let h = PATCH_HEIGHT;
+    let n = mesh.nodes.len();
+    let (slave, master) = match r.slave {
+        Side::Lower => (0..first_upper, first_upper..n),
+        Side::Upper => (first_upper..n, 0..first_upper),
+    };
+    let tol = 1e-9 * PATCH_SIDE;
+    let mut xs: Vec<f64> = mesh.nodes[master.clone()].iter().filter(|x| x[2].abs() < tol).map(|x| x[0]).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup_by(|a, b| (*a - *b).abs() < tol);
+    let g = |x: f64| {
+        let k = xs.partition_point(|&v| v <= x).clamp(1, xs.len() - 1);
+        let (a, b) = (xs[k - 1], xs[k]);
+        let t = (x - a) / (b - a);
+        (1.0 - t) * r.joint_height(a) + t * r.joint_height(b)
+    };
+    for i in master {
+        let x = &mut mesh.nodes[i];
+        x[2] += r.joint_height(x[0]) * (1.0 - x[2].abs() / h);
+    }
+    for i in slave {
+        let x = &mut mesh.nodes[i];
+        x[2] += g(x[0]) * (1.0 - x[2].abs() / h);
+    }
+    if let Some(c) = (0..mesh.cells.len()).filter(|&c| matches!(mesh.cells[c].kind, crate::mesh::CellKind::Tet4 | crate::mesh::CellKind::Hex8)).find(|&c| !(mesh.min_corner_jacobian(c) > 0.0)) {
+        let x = mesh.cells[c].nodes().iter().map(|&k| mesh.x(k as usize)).sum::<Vector3<f64>>() / mesh.cells[c].nodes().len() as f64;
+        return Err(invalid("curvature", format!("R = {:?} turns the element at ({:.3}, {:.3}, {:.3}) inside out: use a larger |R| or more layers", r.curvature, x[0], x[1], x[2])));
+    }
+    Ok(())
 }
 
 /// The in-plane map of `offset` and `rotate` (see [`CaseSpec`]) for the box `b`: interior grid
@@ -547,11 +640,11 @@ fn shift_and_turn(b: &BoxSpec, s: f64, theta_deg: f64, x: f64, y: f64) -> (f64, 
 }
 
 /// The exact local stress of the patch (xx, yy, zz, xy, yz, zx).
-fn patch_stress(r: &Resolved) -> [f64; 6] {
+pub fn patch_stress(r: &Resolved) -> [f64; 6] {
     [0.0, 0.0, -r.pressure, 0.0, 0.0, r.shear]
 }
 
-fn sym(s: &[f64; 6]) -> Matrix3<f64> {
+pub(crate) fn sym(s: &[f64; 6]) -> Matrix3<f64> {
     Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2])
 }
 
@@ -600,6 +693,12 @@ fn newmark_reference(r: &Resolved, scene: &Value) -> Result<Reference, Error> {
 
 fn reference(r: &Resolved) -> Reference {
     match r.kind {
+        Kind::Patch if r.curvature.is_some() => Reference::Patch {
+            stress: patch_stress(r),
+            pressure: r.pressure,
+            shear: 0.0,
+            formula: "uniform state of ν = 0: σzz = −p in every element (local frame), u = −(p/E)(z + H) e_z; on the cylindrical joint the traction σ n = −p n_z e_z (normal p n_z², shear p n_z |n_x|, held by friction: μ > the joint's steepest slope); exact force at a slave node σ V_s, V_s = Σ_f n_f ∫ N_I dA its area vector".into(),
+        },
         Kind::Patch => Reference::Patch {
             stress: patch_stress(r),
             pressure: r.pressure,

@@ -16,8 +16,11 @@ fn case(v: serde_json::Value) -> CaseResult {
     println!("{v}: error {:.4e} ({}), {:?}, lost {}", r.error, r.error_of, r.errors, r.lost);
     if let Errors::Patch { converged, residual, total, .. } = &r.errors {
         assert!(*converged && *residual < 1e-10, "{v}: static solve not converged ({residual:.2e})");
-        // global equilibrium of the joint: Σ r_n = p A (or ≈ 0 in pure shear, relative to τ A)
-        assert!(total.abs() < 1e-6, "{v}: Σ r_n off by {total:.2e}");
+        // global equilibrium of a flat joint: Σ r_n = p A (or ≈ 0 in pure shear, relative to τ A);
+        // on a curved joint Σ r_n also depends on how the force splits into normal and shear
+        if v.get("curvature").is_none() {
+            assert!(total.abs() < 1e-6, "{v}: Σ r_n off by {total:.2e}");
+        }
     }
     r
 }
@@ -105,6 +108,30 @@ fn offset_and_turned_meshes_within_measured_bounds() {
     assert!(r.error < 0.13 && r.error > 0.02, "turned 15° NTS σzz {:.4}", r.error);
 }
 
+/// Cylindrical joints (radius R = 1 m, axis along y: the lower block bulges 0.134 m into the
+/// upper; slave nodes placed on the master's facets). Reference: the uniform σzz = −p, exactly
+/// linear, so exact on conforming meshes whatever the shape; on the cylinder it is a normal
+/// and a shear traction (σ n = −p n_z e_z), held by friction. Measured on the conforming hex
+/// 3×3 joint: NTN 1.3e-10 (bound 1e-8), NTS 0.521 % (bound 0.0065; it falls as about 1/R²:
+/// 0.146 % at R = 2 m, 0.031 % at 5 m, so it is the facet kink, 19° here, not the mesh
+/// ratio); hex 4×4 slave on 3×3: NTS σ 8.28 % (bound 0.105), NTN 74.5 % (larger).
+#[test]
+fn cylindrical_joint_patch_within_measured_bounds() {
+    let conf = json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "curvature": 1.0});
+    let mut ntn = conf.clone();
+    ntn["method"] = json!("ntn");
+    let r = case(ntn);
+    assert!(r.error < 1e-8, "conforming cylinder NTN σ {:.3e}", r.error);
+    let r = case(conf);
+    assert!(r.error < 0.0065, "conforming cylinder NTS σ {:.4e}", r.error);
+    let fine = json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "curvature": 1.0});
+    let nts = case(fine.clone());
+    let mut n = fine;
+    n["method"] = json!("ntn");
+    let ntn = case(n);
+    assert!(nts.error < 0.105 && ntn.error > nts.error, "cylinder 4×4 on 3×3: NTS {:.4}, NTN {:.4}", nts.error, ntn.error);
+}
+
 /// Issue 13 §3: a tied NTS interface between non-conforming meshes (hex 4×4 slave on 3×3)
 /// passes a uniform stress with the error of NTS (measured σzz 8.40 %, bound 0.105) and a
 /// uniform shear (pure shear τ = 1 MPa, p = 0, edge_tolerance 0.05: σ 5.89 %, shear traction
@@ -176,6 +203,12 @@ fn bad_testcase_options_are_named() {
     let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "shear": 7e5})).unwrap();
     let e = build(&spec).err().expect("τ ≥ μ p is refused").to_string();
     assert!(e.contains("`shear`") && e.contains("tied"), "{e}");
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "curvature": 0.6, "mu": 0.3})).unwrap();
+    let e = build(&spec).err().expect("μ below the cylinder's slope is refused").to_string();
+    assert!(e.contains("`curvature`") && e.contains("slope"), "{e}");
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "upper": "hex8:10", "rotate": 45.0})).unwrap();
+    let e = build(&spec).err().expect("an inverted element is refused").to_string();
+    assert!(e.contains("`rotate`") && e.contains("inside out"), "{e}");
     let spec: CaseSpec = serde_json::from_value(json!({"kind": "slide", "slave": "lower"})).unwrap();
     assert!(build(&spec).err().unwrap().to_string().contains("`slave`"));
     let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "lower": "hex8:200:200", "upper": "hex8:200:200"})).unwrap();
