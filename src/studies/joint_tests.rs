@@ -180,7 +180,7 @@ impl StudyKind for JointTestsKind {
             "\n**Published behaviour for comparison (not run here).** CalculiX: the ccx manual asks for a slave side of node-to-face penalty contact at least as fine as the master (ccx 2.7 manual, \"Node-to-face penalty contact\", http://web.mit.edu/calculix_v2.7/CalculiX/ccx_2.7/doc/ccx/node111.html) and says its face-to-face penalty contact, integrated over the triangulated overlaps of slave and master faces, \"usually leads to a very smooth pressure distribution\" whichever side is slave (ccx 2.11 manual, \"Face-to-face penalty contact\"). The figure quoted by issue 20, node-to-face missing σzz by 34 % on the 4×4-over-3×3 hex8 patch test with face-to-face exact, could not be traced to a published source (manual, ccx test examples, CalculiX issue tracker; docs/validation.md §8): it is plotted as the issue's figure. A mortar-type option here would be measured against the NTS rows above.\n"
         );
         // chart: patch pressure cases, headline error against mesh ratio, one series per method
-        let mut chart = Chart::new("Patch test: σzz error next to the joint against mesh ratio", "h_slave / h_master", "largest |σzz/(−p) − 1| [%]");
+        let mut chart = Chart::new("Patch test: σzz error next to the joint against mesh ratio", "h_slave / h_master", "largest |σzz/(−p) − 1| (cylinders: any σ component, / p) [%]");
         let mut methods: Vec<String> = Vec::new();
         for (_, r) in &done {
             if r.spec.kind == Kind::Patch && r.spec.shear == 0.0 {
