@@ -176,7 +176,7 @@ enum Cmd {
         /// patch (uniform pressure/shear through the joint, static), slide (block on an
         /// incline), newmark (the block under a base record against rigid Newmark), impact (two bars).
         kind: String,
-        /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2.
+        /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2, mixed:4 (ELEMENT hex8, tet4 or mixed).
         #[arg(long)]
         lower: Option<String>,
         /// Upper side ELEMENT:N[:LAYERS].
@@ -227,6 +227,18 @@ enum Cmd {
         /// The joint's edge_tolerance (fraction of the master face size).
         #[arg(long)]
         edge_tolerance: Option<f64>,
+        /// Shift of the upper side's interior grid lines in the joint plane, as a fraction of
+        /// its element (|s| < 1).
+        #[arg(long, allow_negative_numbers = true)]
+        offset: Option<f64>,
+        /// Turn of the upper side's mesh about the joint normal [deg] (inner half rigid, blended
+        /// to 0 at the outline; |θ| ≤ 45).
+        #[arg(long, allow_negative_numbers = true)]
+        rotate: Option<f64>,
+        /// Patch: a cylindrical joint of radius R [m] (axis along y; R > 0 the lower block
+        /// bulges up, R < 0 a trough; |R| > 0.5); μ must exceed the steepest slope.
+        #[arg(long, allow_negative_numbers = true)]
+        curvature: Option<f64>,
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
@@ -607,10 +619,13 @@ fn real_main() -> Result<()> {
         }
         Cmd::Study { action } => study_cmd(action)?,
         Cmd::Record { action } => record_cmd(action)?,
-        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, record, pga, out, run, json } => {
+        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, offset, rotate, curvature, record, pga, out, run, json } => {
             // the options as the study file writes a case (one parser and one set of checks)
             let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
-            let opts: [(&str, serde_json::Value); 15] = [
+            let opts: [(&str, serde_json::Value); 18] = [
+                ("curvature", curvature.into()),
+                ("offset", offset.into()),
+                ("rotate", rotate.into()),
                 ("record", record.map(|p| p.display().to_string()).into()),
                 ("pga", pga.into()),
                 ("edge_tolerance", edge_tolerance.into()),

@@ -121,6 +121,29 @@ pub fn tributary_areas_into(surface: &Surface, out: &mut [f64]) {
     }
 }
 
+/// Area vector of every node of `surface` (local node order) into `out`: Σ over its faces of
+/// n_f ∫ N_I dA (n_f the face's outward unit normal, ∫ N_I dA as in [`tributary_areas_into`];
+/// exact for planar faces). A uniform stress σ loads node I with σ · (its area vector), whatever
+/// the shape of the surface: the exact nodal force of a patch test on a curved joint.
+pub fn tributary_vectors_into(surface: &Surface, out: &mut [[f64; 3]]) {
+    assert_eq!(out.len(), surface.nodes.len());
+    out.iter_mut().for_each(|a| *a = [0.0; 3]);
+    let mut t = [0.0; 4];
+    for (f, face) in surface.faces.iter().enumerate() {
+        let (x, n) = surface.face_points(f);
+        match face.kind {
+            CellKind::Quad4 => quad_tributary(&x, &mut t),
+            _ => t = [face_area(face.kind, &x[..3]) / 3.0; 4],
+        }
+        let nf = face_unit_normal(face.kind, &x[..n]);
+        for (k, &l) in face.local_nodes().iter().enumerate().take(n) {
+            for c in 0..3 {
+                out[l as usize][c] += nf[c] * t[k];
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -292,22 +292,23 @@ pub fn write_msh41(mesh: &Mesh, path: &std::path::Path) -> std::io::Result<()> {
     }
     let _ = writeln!(s, "$EndNodes");
     let total: usize = mesh.groups.iter().filter(|g| g.dim >= 1).map(|g| g.cells.len()).sum();
-    let blocks: Vec<(usize, &Group)> = mesh.groups.iter().enumerate().filter(|(_, g)| !g.cells.is_empty()).collect();
+    // one element block per (group, cell kind): a group that mixes kinds (a block of hexes and
+    // tets) is one entity with several blocks, as gmsh writes hybrid meshes
+    const KINDS: [(CellKind, usize); 4] = [(CellKind::Tri3, 2), (CellKind::Quad4, 3), (CellKind::Tet4, 4), (CellKind::Hex8, 5)];
+    let mut blocks: Vec<(usize, &Group, CellKind, usize, usize)> = Vec::new();
+    for (k, g) in mesh.groups.iter().enumerate() {
+        for (kind, ty) in KINDS {
+            let n = g.cells.iter().filter(|&&c| mesh.cells[c].kind == kind).count();
+            if n > 0 {
+                blocks.push((k, g, kind, ty, n));
+            }
+        }
+    }
     let _ = writeln!(s, "$Elements\n{} {} 1 {}", blocks.len(), total, total);
     let mut etag = 0;
-    for (k, g) in blocks {
-        let kind = mesh.cells[g.cells[0]].kind;
-        let ty = match kind {
-            CellKind::Tri3 => 2,
-            CellKind::Quad4 => 3,
-            CellKind::Tet4 => 4,
-            CellKind::Hex8 => 5,
-        };
-        if g.cells.iter().any(|&c| mesh.cells[c].kind != kind) {
-            return Err(std::io::Error::other(format!("group {} mixes cell kinds; write_msh41 needs one kind per group", g.name)));
-        }
-        let _ = writeln!(s, "{} {} {} {}", g.dim, k + 1, ty, g.cells.len());
-        for &c in &g.cells {
+    for (k, g, kind, ty, n) in blocks {
+        let _ = writeln!(s, "{} {} {} {}", g.dim, k + 1, ty, n);
+        for &c in g.cells.iter().filter(|&&c| mesh.cells[c].kind == kind) {
             etag += 1;
             let _ = write!(s, "{etag}");
             for &nd in mesh.cells[c].nodes() {
@@ -318,4 +319,29 @@ pub fn write_msh41(mesh: &Mesh, path: &std::path::Path) -> std::io::Result<()> {
     }
     let _ = writeln!(s, "$EndElements");
     std::fs::write(path, s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::structured::{box_mesh, BoxSpec};
+
+    /// A block of hexes and tets (one group, two cell kinds) is written as one entity with two
+    /// element blocks and reads back with the same cells per group and kind.
+    #[test]
+    fn mixed_block_round_trips_through_msh41() {
+        let m = box_mesh(&BoxSpec::new("b", [1.0, 1.0, 0.5], [3, 3, 2]).mixed(true));
+        let dir = std::env::temp_dir().join(format!("jq-msh-mixed-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("mixed.msh");
+        write_msh41(&m, &path).unwrap();
+        let r = parse_msh(&std::fs::read(&path).unwrap(), path.clone()).unwrap();
+        let count = |mesh: &Mesh, g: &str, k: CellKind| mesh.group(g).unwrap().cells.iter().filter(|&&c| mesh.cells[c].kind == k).count();
+        for (g, k) in [("block:b", CellKind::Hex8), ("block:b", CellKind::Tet4), ("b:z1", CellKind::Quad4), ("b:z1", CellKind::Tri3)] {
+            assert_eq!(count(&r, g, k), count(&m, g, k), "{g} {k:?}");
+            assert!(count(&m, g, k) > 0);
+        }
+        assert_eq!(r.nodes.len(), m.nodes.len());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

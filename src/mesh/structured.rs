@@ -1,7 +1,11 @@
 //! Structured box meshes built in memory (tests and benchmarks need no gmsh).
 //!
 //! A box [x0, x0+lx] × [y0, y0+ly] × [z0, z0+lz] split into nx × ny × nz hexahedra, or each hexahedron
-//! split into 6 tetrahedra along its main diagonal (Kuhn split: conforming across the grid).
+//! split into 6 tetrahedra along its main diagonal (Kuhn split: conforming across the grid), or
+//! both (`mixed`): the cells of the first ⌈nx/2⌉ columns along x are hexahedra, the others tets.
+//! In a mixed box a hex face meets the two triangles of the Kuhn split on the same four nodes (no
+//! pyramids: the element library has tet4 and hex8 only), so the displacement is continuous at
+//! the nodes and for every linear field (what a patch test exercises), not for general fields.
 //! Groups: `block:<name>` (volume) and the six boundary faces `<name>:x0`, `<name>:x1`,
 //! `<name>:y0`, `<name>:y1`, `<name>:z0`, `<name>:z1` (quad4 or tri3, outward orientation).
 
@@ -16,15 +20,25 @@ pub struct BoxSpec {
     pub size: [f64; 3],
     pub divisions: [usize; 3],
     pub tets: bool,
+    /// Hexes in the first ⌈nx/2⌉ columns along x, Kuhn tets in the rest (module doc).
+    pub mixed: bool,
 }
 
 impl BoxSpec {
     pub fn new(name: &str, size: [f64; 3], divisions: [usize; 3]) -> BoxSpec {
-        BoxSpec { name: name.into(), origin: [0.0; 3], size, divisions, tets: false }
+        BoxSpec { name: name.into(), origin: [0.0; 3], size, divisions, tets: false, mixed: false }
     }
     pub fn tets(mut self, yes: bool) -> Self {
         self.tets = yes;
         self
+    }
+    pub fn mixed(mut self, yes: bool) -> Self {
+        self.mixed = yes;
+        self
+    }
+    /// True when the cell in column `i` (along x) is split into tets.
+    pub fn is_tet_column(&self, i: usize) -> bool {
+        self.tets || (self.mixed && i >= self.divisions[0].div_ceil(2))
     }
     pub fn at(mut self, origin: [f64; 3]) -> Self {
         self.origin = origin;
@@ -53,6 +67,8 @@ pub fn add_box(mesh: &mut Mesh, spec: &BoxSpec) {
     }
     let mut etag = mesh.cells.iter().map(|c| c.tag).max().unwrap_or(0);
     let first_cell = mesh.cells.len();
+    // grid cell (i, j, k) of each volume cell (6 per grid cell where split)
+    let mut grid: Vec<(usize, usize, usize)> = Vec::new();
     for k in 0..nz {
         for j in 0..ny {
             for i in 0..nx {
@@ -66,7 +82,7 @@ pub fn add_box(mesh: &mut Mesh, spec: &BoxSpec) {
                     id(i + 1, j + 1, k + 1),
                     id(i, j + 1, k + 1),
                 ];
-                if spec.tets {
+                if spec.is_tet_column(i) {
                     // Kuhn split: paths 0 → 6 along the three axes in every order
                     let step = |v: usize, axis: usize| -> usize {
                         // local hex ids by (x,y,z) bits
@@ -85,10 +101,12 @@ pub fn add_box(mesh: &mut Mesh, spec: &BoxSpec) {
                         }
                         etag += 1;
                         mesh.cells.push(Cell::new(CellKind::Tet4, etag, &t));
+                        grid.push((i, j, k));
                     }
                 } else {
                     etag += 1;
                     mesh.cells.push(Cell::new(CellKind::Hex8, etag, &h));
+                    grid.push((i, j, k));
                 }
             }
         }
@@ -102,14 +120,12 @@ pub fn add_box(mesh: &mut Mesh, spec: &BoxSpec) {
     // and orientation of `topology::boundary_faces` over the whole block followed by the plane
     // test below, without a face map of the whole block (test
     // `boundary_groups_equal_a_search_over_every_cell`).
-    let per_cell = if spec.tets { 6 } else { 1 };
     let tol = 1e-9 * spec.size.iter().fold(0.0f64, |a, &b| a.max(b));
     let planes = [("x0", 0, spec.origin[0]), ("x1", 0, spec.origin[0] + spec.size[0]), ("y0", 1, spec.origin[1]), ("y1", 1, spec.origin[1] + spec.size[1]), ("z0", 2, spec.origin[2]), ("z1", 2, spec.origin[2] + spec.size[2])];
     let on_plane = |mesh: &Mesh, nodes: &[usize]| planes.iter().any(|&(_, axis, value)| nodes.iter().all(|&n| (mesh.nodes[n][axis] - value).abs() <= tol));
     let mut faces = Vec::new();
     for &c in &vol_cells {
-        let g = (c - first_cell) / per_cell;
-        let (i, j, k) = (g % nx, (g / nx) % ny, g / (nx * ny));
+        let (i, j, k) = grid[c - first_cell];
         if !(i == 0 || j == 0 || k == 0 || i + 1 == nx || j + 1 == ny || k + 1 == nz) {
             continue;
         }
@@ -181,6 +197,36 @@ mod tests {
             };
             assert!((vol - 1.5 * 0.7 * 2.0).abs() < 1e-12, "tets {tets}: volume {vol}");
         }
+    }
+
+    #[test]
+    fn mixed_box_has_hex_then_tet_columns_filling_the_box() {
+        // 3 columns along x: 2 of hexes, 1 of Kuhn tets; every cell positive, the volumes sum to the
+        // box's, the top face has 2×2 quads and 1×2×2 triangles
+        let m = box_mesh(&BoxSpec::new("b", [1.5, 1.0, 0.5], [3, 2, 2]).mixed(true));
+        let g = m.group("block:b").unwrap();
+        let hexes = g.cells.iter().filter(|&&c| m.cells[c].kind == CellKind::Hex8).count();
+        let tets = g.cells.iter().filter(|&&c| m.cells[c].kind == CellKind::Tet4).count();
+        assert_eq!((hexes, tets), (2 * 2 * 2, 6 * 2 * 2));
+        assert!(g.cells.iter().all(|&c| m.min_corner_jacobian(c) > 0.0));
+        let vol: f64 = g
+            .cells
+            .iter()
+            .map(|&c| match m.cells[c].kind {
+                CellKind::Tet4 => m.min_corner_jacobian(c) / 6.0,
+                _ => {
+                    let n = m.cells[c].nodes();
+                    (0..3).map(|i| m.nodes[n[6] as usize][i] - m.nodes[n[0] as usize][i]).product::<f64>()
+                }
+            })
+            .sum();
+        assert!((vol - 0.75).abs() < 1e-12, "volume {vol}");
+        let top = &m.group("b:z1").unwrap().cells;
+        let quads = top.iter().filter(|&&c| m.cells[c].kind == CellKind::Quad4).count();
+        assert_eq!((quads, top.len() - quads), (4, 4));
+        // every x0 face is a quad (hex column), every x1 face a triangle (tet column)
+        assert!(m.group("b:x0").unwrap().cells.iter().all(|&c| m.cells[c].kind == CellKind::Quad4));
+        assert!(m.group("b:x1").unwrap().cells.iter().all(|&c| m.cells[c].kind == CellKind::Tri3));
     }
 
     #[test]

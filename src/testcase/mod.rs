@@ -16,8 +16,9 @@
 //! - **Groups** (from `mesh::structured`): `block:lower`, `block:upper`; faces `lower:z1` and
 //!   `upper:z0` are the two sides of joint `J`; `lower:z0` is fixed (base); the other faces
 //!   `<block>:x0 … z1` carry the tractions of the exact state.
-//! - **Sides**: `ELEMENT:N[:LAYERS]`, e.g. `hex8:4`, `tet4:3:2`: hex8 or tet4 (each grid cell
-//!   split into 6 tets, Kuhn), N divisions per unit length in x and y, LAYERS element layers
+//! - **Sides**: `ELEMENT:N[:LAYERS]`, e.g. `hex8:4`, `tet4:3:2`, `mixed:4`: hex8, tet4 (each grid
+//!   cell split into 6 tets, Kuhn) or mixed (hex8 in the first ⌈N/2⌉ columns along x, tet4 in the
+//!   rest: the joint face is half quads, half triangles; `mesh::structured`), N divisions per unit length in x and y, LAYERS element layers
 //!   through the block (default 2).
 //! - **Slave**: the side whose nodes are paired (`lower` or `upper`); default the finer side
 //!   (more in-plane divisions; `upper` on a tie), the tagger's own rule.
@@ -29,6 +30,15 @@
 //!   as the tractions σ·n of that state on every free face. Exact: that stress in every
 //!   element, contact pressure p and shear traction τ at every slave node (r = p A_s). Solved
 //!   statically (dynamic relaxation with adaptive critical damping, [`run`]).
+//!   With `curvature` R the joint is a cylinder (axis along y, [`CaseSpec::curvature`]) under
+//!   the same pressure state σzz = −p: it is exactly linear (u = −(p/E)(z + H) e_z), so a
+//!   conforming mesh reproduces it to round-off whatever the joint's shape, and on the cylinder it
+//!   is the traction σ n = −p n_z e_z, normal p n_z² and shear p n_z |n_x| (stick needs μ above the
+//!   steepest slope, tan α = ½ / √(R² − ¼)); the exact force at a slave node is σ · Σ_f n_f ∫ N_I dA.
+//!   (A Lamé solution of concentric cylinders under radial pressure would mix the elements' own
+//!   error into the contact's, and needs rollers on joint nodes, which the contact force treats as
+//!   fixed nodes (`contact::force`, inverse mass 0 for any fixed component); this state keeps the
+//!   patch test's property that any error is the joint's.)
 //! - `slide`: a 1 × 0.5 × 0.5 m block on a 4 × 1 × 0.5 m base inclined at β, μ < tan β, gravity
 //!   from rest: s(t) = ½ g (sin β − μ cos β) t² down the slope (refs/analytic.py B).
 //! - `newmark`: the `slide` geometry with μ ≥ tan β (the block holds under gravity), gravity
@@ -80,6 +90,9 @@ impl std::str::FromStr for Kind {
 pub enum Element {
     Hex8,
     Tet4,
+    /// Hex8 in the first ⌈N/2⌉ columns along x, tet4 (Kuhn split) in the rest
+    /// (`mesh::structured`), so the joint face is half quads, half triangles.
+    Mixed,
 }
 
 /// One side's mesh: `ELEMENT:N[:LAYERS]` (see the module conventions).
@@ -96,13 +109,14 @@ impl std::str::FromStr for SideSpec {
     type Err = String;
     fn from_str(s: &str) -> Result<SideSpec, String> {
         let parts: Vec<&str> = s.split(':').collect();
-        let bad = || format!("\"{s}\": write ELEMENT:N[:LAYERS], e.g. hex8:4 or tet4:3:2 (ELEMENT hex8 or tet4, N and LAYERS whole numbers from 1 to 200)");
+        let bad = || format!("\"{s}\": write ELEMENT:N[:LAYERS], e.g. hex8:4 or tet4:3:2 (ELEMENT hex8, tet4 or mixed, N and LAYERS whole numbers from 1 to 200)");
         if parts.len() < 2 || parts.len() > 3 {
             return Err(bad());
         }
         let element = match parts[0] {
             "hex8" => Element::Hex8,
             "tet4" => Element::Tet4,
+            "mixed" => Element::Mixed,
             _ => return Err(bad()),
         };
         let num = |t: &str| t.parse::<usize>().ok().filter(|&v| (1..=200).contains(&v)).ok_or_else(bad);
@@ -117,6 +131,7 @@ impl std::fmt::Display for SideSpec {
         let e = match self.element {
             Element::Hex8 => "hex8",
             Element::Tet4 => "tet4",
+            Element::Mixed => "mixed",
         };
         write!(f, "{e}:{}:{}", self.n, self.layers)
     }
@@ -210,6 +225,27 @@ pub struct CaseSpec {
     /// master by dt² F/m; above this tolerance it is lost (docs/validation.md §8).
     #[serde(default)]
     pub edge_tolerance: Option<f64>,
+    /// Shift of the upper side's mesh in the joint plane, as a fraction s of its element size h:
+    /// its interior grid lines (x and y) move by s·h, its outline stays (the joint is the same
+    /// rectangle on both sides, which the exact references need), so its first row of elements
+    /// is (1 + s) h wide and its last (1 − s) h. |s| < 1; needs N ≥ 2. Default 0.
+    #[serde(default)]
+    pub offset: Option<f64>,
+    /// Turn of the upper side's mesh about the joint normal [deg]: every node at "square radius"
+    /// ρ = max(|x − x_c|/(l_x/2), |y − y_c|/(l_y/2)) from the joint's centre turns by θ·w(ρ), w = 1
+    /// for ρ ≤ ½ (the inner half is the grid rigidly turned by θ) and 2 (1 − ρ) beyond, so the
+    /// outline stays. |θ| ≤ 45; an element turned inside out is refused. Default 0.
+    #[serde(default)]
+    pub rotate: Option<f64>,
+    /// Patch: a cylindrical joint of radius R [m], axis along local y through the joint's edges
+    /// x = 0 and x = 1 m: z = f(x) = sgn R (√(R² − (x − ½)²) − √(R² − ¼)) (R > 0: the lower block
+    /// bulges into the upper one; R < 0: a trough). The master side's joint nodes lie on the
+    /// cylinder, the slave side's on the master's facets (the initial gap is zero, as CalculiX and
+    /// Abaqus adjust slave nodes); every node column is moved by f(1 − |z|/H). The pressure state
+    /// σzz = −p is unchanged (module doc); μ must exceed the steepest slope ½/√(R² − ¼) unless
+    /// tied. |R| > 0.5 m; default flat.
+    #[serde(default)]
+    pub curvature: Option<f64>,
 }
 
 /// Patch material and geometry (module conventions).
@@ -249,6 +285,14 @@ pub struct Resolved {
     pub duration: f64,
     pub residual: f64,
     pub edge_tolerance: Option<f64>,
+    /// Upper side's in-plane shift (fraction of its element) and turn [deg] (see [`CaseSpec`]).
+    #[serde(default)]
+    pub offset: f64,
+    #[serde(default)]
+    pub rotate: f64,
+    /// Patch: radius of the cylindrical joint [m] (see [`CaseSpec`]); None: flat.
+    #[serde(default)]
+    pub curvature: Option<f64>,
     /// Newmark: the record (absolute path) and its PGA [g].
     pub record: Option<PathBuf>,
     pub pga: f64,
@@ -342,16 +386,46 @@ impl CaseSpec {
         if let Some(e) = self.edge_tolerance.filter(|e| !(e.is_finite() && *e > 0.0 && *e < 1.0)) {
             return Err(invalid("edge_tolerance", format!("{e}: give a fraction of the face size in (0, 1)")));
         }
+        let offset = self.offset.unwrap_or(0.0);
+        if !(offset.is_finite() && offset.abs() < 1.0) {
+            return Err(invalid("offset", format!("{offset}: give a fraction of the upper side's element with |s| < 1 (0.3: its interior grid lines move by 0.3 h)")));
+        }
+        if offset != 0.0 && upper.n < 2 {
+            return Err(invalid("offset", format!("the upper side {upper} has no interior grid line to shift: give N ≥ 2")));
+        }
+        let rotate = self.rotate.unwrap_or(0.0);
+        if !(rotate.is_finite() && rotate.abs() <= 45.0) {
+            return Err(invalid("rotate", format!("{rotate}: give |θ| ≤ 45 deg")));
+        }
+        if let Some(rc) = self.curvature {
+            if k != Kind::Patch {
+                return Err(invalid("curvature", "only the patch kind has a cylindrical joint"));
+            }
+            if !(rc.is_finite() && rc.abs() > 0.5 * PATCH_SIDE) {
+                return Err(invalid("curvature", format!("R = {rc}: give |R| > {} m (the joint's half-width)", 0.5 * PATCH_SIDE)));
+            }
+            if shear != 0.0 || rotate != 0.0 || self.massless_lower {
+                return Err(invalid("curvature", "a cylindrical joint takes the pressure state only: no shear, rotate or massless_lower"));
+            }
+            if pressure == 0.0 {
+                return Err(invalid("curvature", "give a pressure p > 0"));
+            }
+            let c = 0.5 * PATCH_SIDE;
+            let slope = c / (rc * rc - c * c).sqrt();
+            if !self.tied && mu <= slope {
+                return Err(invalid("curvature", format!("R = {rc}: the joint's steepest slope tan α = {slope:.4} ≥ μ = {mu}: the blocks would slide (no static solution); raise μ, |R|, or use tied")));
+            }
+        }
         if self.massless_lower && slave == Side::Lower && !self.tied && method == ContactMethod::Ntn {
             return Err(invalid("massless_lower", "NTN on a massless side is not a supported combination; use nts"));
         }
         // size of the problem: refuse what would not fit in memory before allocating it
-        let cells = |s: &SideSpec, len: usize| s.n * s.n * len * s.layers * if s.element == Element::Tet4 { 6 } else { 1 };
+        let cells = |s: &SideSpec, len: usize| s.n * s.n * len * s.layers * if s.element == Element::Hex8 { 1 } else { 6 };
         let total = cells(&lower, if matches!(k, Kind::Slide | Kind::Newmark) { 4 } else { 1 }) + cells(&upper, 1);
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
-        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, record, pga })
+        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, record, pga })
     }
 }
 
@@ -360,6 +434,17 @@ impl Resolved {
     pub fn rotation(&self) -> Matrix3<f64> {
         let (s, c) = self.inclination.to_radians().sin_cos();
         Matrix3::new(c, 0.0, -s, 0.0, 1.0, 0.0, s, 0.0, c)
+    }
+
+    /// Height of the exact joint surface above the local plane z = 0 at local x [m] (0 when flat).
+    pub fn joint_height(&self, x: f64) -> f64 {
+        match self.curvature {
+            Some(rc) => {
+                let c = 0.5 * PATCH_SIDE;
+                rc.signum() * ((rc * rc - (x - c) * (x - c)).max(0.0).sqrt() - (rc * rc - c * c).sqrt())
+            }
+            None => 0.0,
+        }
     }
 
     /// The slave's and master's face groups.
@@ -389,7 +474,17 @@ impl Resolved {
     /// A short label: `patch hex8:4:2/hex8:3:2 slave lower nts`.
     pub fn label(&self) -> String {
         let m = if self.tied { format!("{} tied", self.method.as_str()) } else { self.method.as_str().to_string() };
-        format!("{:?} {}/{} slave {:?} {m}", self.kind, self.lower, self.upper, self.slave).to_lowercase()
+        let mut l = format!("{:?} {}/{} slave {:?} {m}", self.kind, self.lower, self.upper, self.slave).to_lowercase();
+        if self.offset != 0.0 {
+            l += &format!(" offset {}", self.offset);
+        }
+        if self.rotate != 0.0 {
+            l += &format!(" rotate {}", self.rotate);
+        }
+        if let Some(rc) = self.curvature {
+            l += &format!(" cylinder R {rc}");
+        }
+        l
     }
 }
 
@@ -420,7 +515,7 @@ pub struct Case {
 /// Build the case of `spec`.
 pub fn build(spec: &CaseSpec) -> Result<Case, Error> {
     let r = spec.resolved()?;
-    let mesh = case_mesh(&r);
+    let mesh = case_mesh(&r)?;
     let scene = case_scene(&r);
     let reference = match r.kind {
         Kind::Newmark => newmark_reference(&r, &scene)?,
@@ -432,30 +527,53 @@ pub fn build(spec: &CaseSpec) -> Result<Case, Error> {
 fn side_box(name: &str, side: &SideSpec, size: [f64; 3], origin: [f64; 3], along: [f64; 2]) -> BoxSpec {
     let nx = ((side.n as f64 * along[0]).round() as usize).max(1);
     let ny = ((side.n as f64 * along[1]).round() as usize).max(1);
-    BoxSpec::new(name, size, [nx, ny, side.layers]).at(origin).tets(side.element == Element::Tet4)
+    BoxSpec::new(name, size, [nx, ny, side.layers]).at(origin).tets(side.element == Element::Tet4).mixed(side.element == Element::Mixed)
 }
 
-/// The two blocks in the local frame, rotated by R.
-pub fn case_mesh(r: &Resolved) -> Mesh {
+/// The two blocks in the local frame, the upper side's mesh shifted and turned in the joint
+/// plane (`offset`, `rotate`), the whole rotated by R. An element turned inside out by the turn
+/// is an error naming `rotate`.
+pub fn case_mesh(r: &Resolved) -> Result<Mesh, Error> {
     let mut mesh = Mesh { source: PathBuf::from(format!("<testcase {}>", r.label())), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
-    match r.kind {
+    // the upper box and its footprint in the joint plane (origin, size)
+    let upper = match r.kind {
         Kind::Patch => {
             let (a, h) = (PATCH_SIDE, PATCH_HEIGHT);
             add_box(&mut mesh, &side_box("lower", &r.lower, [a, a, h], [0.0, 0.0, -h], [1.0, 1.0]));
-            add_box(&mut mesh, &side_box("upper", &r.upper, [a, a, h], [0.0, 0.0, 0.0], [1.0, 1.0]));
+            side_box("upper", &r.upper, [a, a, h], [0.0, 0.0, 0.0], [1.0, 1.0])
         }
         Kind::Slide | Kind::Newmark => {
             // base 4 × 1 × 0.5 m from x = −0.5; slider 1 × 0.5 × 0.5 m at x ∈ [2, 3], y ∈ [0.25, 0.75]
             add_box(&mut mesh, &side_box("lower", &r.lower, [4.0, 1.0, 0.5], [-0.5, 0.0, -0.5], [4.0, 1.0]));
-            add_box(&mut mesh, &side_box("upper", &r.upper, [1.0, 0.5, 0.5], [2.0, 0.25, 0.0], [1.0, 0.5]));
+            side_box("upper", &r.upper, [1.0, 0.5, 0.5], [2.0, 0.25, 0.0], [1.0, 0.5])
         }
         Kind::Impact => {
             let a = BAR_A;
             let bar = |s: &SideSpec| [s.n, s.n, s.layers];
             let (lo, up) = (r.lower, r.upper);
-            add_box(&mut mesh, &BoxSpec::new("lower", [a, a, BAR_L], bar(&lo)).at([0.0, 0.0, -BAR_L]).tets(lo.element == Element::Tet4));
-            add_box(&mut mesh, &BoxSpec::new("upper", [a, a, BAR_L], bar(&up)).tets(up.element == Element::Tet4));
+            add_box(&mut mesh, &BoxSpec::new("lower", [a, a, BAR_L], bar(&lo)).at([0.0, 0.0, -BAR_L]).tets(lo.element == Element::Tet4).mixed(lo.element == Element::Mixed));
+            BoxSpec::new("upper", [a, a, BAR_L], bar(&up)).tets(up.element == Element::Tet4).mixed(up.element == Element::Mixed)
         }
+    };
+    let first_upper = mesh.nodes.len();
+    add_box(&mut mesh, &upper);
+    if r.offset != 0.0 || r.rotate != 0.0 {
+        for x in &mut mesh.nodes[first_upper..] {
+            let (px, py) = shift_and_turn(&upper, r.offset, r.rotate, x[0], x[1]);
+            x[0] = px;
+            x[1] = py;
+        }
+        let cells = &mesh.group("block:upper").expect("the upper block's group").cells;
+        if let Some(&c) = cells.iter().find(|&&c| !(mesh.min_corner_jacobian(c) > 0.0)) {
+            let x = mesh.cells[c].nodes().iter().map(|&n| mesh.x(n as usize)).sum::<Vector3<f64>>() / mesh.cells[c].nodes().len() as f64;
+            return Err(invalid(
+                "rotate",
+                format!("θ = {} deg with offset {} turns the upper element at ({:.3}, {:.3}, {:.3}) inside out; use a smaller turn or a coarser upper side", r.rotate, r.offset, x[0], x[1], x[2]),
+            ));
+        }
+    }
+    if r.curvature.is_some() {
+        curve_joint(r, &mut mesh, first_upper)?;
     }
     let rot = r.rotation();
     if r.inclination != 0.0 {
@@ -464,15 +582,69 @@ pub fn case_mesh(r: &Resolved) -> Mesh {
             *x = [y[0], y[1], y[2]];
         }
     }
-    mesh
+    Ok(mesh)
+}
+
+/// Bend the patch's joint into the cylinder of `curvature`: master nodes by f(x) (1 − |z|/H),
+/// slave nodes by g(x) (1 − |z|/H) with g the piecewise-linear interpolant of f at the master's
+/// joint node abscissae, so the slave's joint nodes lie on the master's facets (zero initial
+/// gap). Nodes `first_upper..` are the upper block's.
+fn curve_joint(r: &Resolved, mesh: &mut Mesh, first_upper: usize) -> Result<(), Error> {
+    let h = PATCH_HEIGHT;
+    let n = mesh.nodes.len();
+    let (slave, master) = match r.slave {
+        Side::Lower => (0..first_upper, first_upper..n),
+        Side::Upper => (first_upper..n, 0..first_upper),
+    };
+    let tol = 1e-9 * PATCH_SIDE;
+    let mut xs: Vec<f64> = mesh.nodes[master.clone()].iter().filter(|x| x[2].abs() < tol).map(|x| x[0]).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup_by(|a, b| (*a - *b).abs() < tol);
+    let g = |x: f64| {
+        let k = xs.partition_point(|&v| v <= x).clamp(1, xs.len() - 1);
+        let (a, b) = (xs[k - 1], xs[k]);
+        let t = (x - a) / (b - a);
+        (1.0 - t) * r.joint_height(a) + t * r.joint_height(b)
+    };
+    for i in master {
+        let x = &mut mesh.nodes[i];
+        x[2] += r.joint_height(x[0]) * (1.0 - x[2].abs() / h);
+    }
+    for i in slave {
+        let x = &mut mesh.nodes[i];
+        x[2] += g(x[0]) * (1.0 - x[2].abs() / h);
+    }
+    if let Some(c) = (0..mesh.cells.len()).filter(|&c| matches!(mesh.cells[c].kind, crate::mesh::CellKind::Tet4 | crate::mesh::CellKind::Hex8)).find(|&c| !(mesh.min_corner_jacobian(c) > 0.0)) {
+        let x = mesh.cells[c].nodes().iter().map(|&k| mesh.x(k as usize)).sum::<Vector3<f64>>() / mesh.cells[c].nodes().len() as f64;
+        return Err(invalid("curvature", format!("R = {:?} turns the element at ({:.3}, {:.3}, {:.3}) inside out: use a larger |R| or more layers", r.curvature, x[0], x[1], x[2])));
+    }
+    Ok(())
+}
+
+/// The in-plane map of `offset` and `rotate` (see [`CaseSpec`]) for the box `b`: interior grid
+/// lines moved by s·h, then the turn θ·w(ρ) about the footprint's centre.
+fn shift_and_turn(b: &BoxSpec, s: f64, theta_deg: f64, x: f64, y: f64) -> (f64, f64) {
+    let (o, l, n) = (b.origin, b.size, b.divisions);
+    let tol = 1e-9 * l[0].max(l[1]);
+    let shift = |v: f64, axis: usize| {
+        let h = l[axis] / n[axis] as f64;
+        if v > o[axis] + tol && v < o[axis] + l[axis] - tol { v + s * h } else { v }
+    };
+    let (x, y) = (shift(x, 0), shift(y, 1));
+    let (cx, cy) = (o[0] + 0.5 * l[0], o[1] + 0.5 * l[1]);
+    let (dx, dy) = (x - cx, y - cy);
+    let rho = (dx.abs() / (0.5 * l[0])).max(dy.abs() / (0.5 * l[1]));
+    let w = if rho <= 0.5 { 1.0 } else { (2.0 * (1.0 - rho)).max(0.0) };
+    let (sn, cs) = (theta_deg.to_radians() * w).sin_cos();
+    (cx + cs * dx - sn * dy, cy + sn * dx + cs * dy)
 }
 
 /// The exact local stress of the patch (xx, yy, zz, xy, yz, zx).
-fn patch_stress(r: &Resolved) -> [f64; 6] {
+pub fn patch_stress(r: &Resolved) -> [f64; 6] {
     [0.0, 0.0, -r.pressure, 0.0, 0.0, r.shear]
 }
 
-fn sym(s: &[f64; 6]) -> Matrix3<f64> {
+pub(crate) fn sym(s: &[f64; 6]) -> Matrix3<f64> {
     Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2])
 }
 
@@ -521,6 +693,12 @@ fn newmark_reference(r: &Resolved, scene: &Value) -> Result<Reference, Error> {
 
 fn reference(r: &Resolved) -> Reference {
     match r.kind {
+        Kind::Patch if r.curvature.is_some() => Reference::Patch {
+            stress: patch_stress(r),
+            pressure: r.pressure,
+            shear: 0.0,
+            formula: "uniform state of ν = 0: σzz = −p in every element (local frame), u = −(p/E)(z + H) e_z; on the cylindrical joint the traction σ n = −p n_z e_z (normal p n_z², shear p n_z |n_x|, held by friction: μ > the joint's steepest slope); exact force at a slave node σ V_s, V_s = Σ_f n_f ∫ N_I dA its area vector".into(),
+        },
         Kind::Patch => Reference::Patch {
             stress: patch_stress(r),
             pressure: r.pressure,
@@ -634,4 +812,28 @@ pub fn write_case(case: &Case, dir: &Path) -> Result<CaseFiles, Error> {
     let refj = json!({"case": case.spec, "reference": case.reference});
     std::fs::write(&reference, serde_json::to_string_pretty(&refj).expect("a reference serialises")).map_err(|e| w(&reference, e))?;
     Ok(CaseFiles { msh, scene, reference })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The in-plane map keeps the outline and moves the inside: interior grid lines by s·h, the
+    /// inner half turned rigidly by θ about the centre (reference: the definitions on `CaseSpec`).
+    #[test]
+    fn shift_and_turn_keeps_the_outline_and_turns_the_inner_half() {
+        let b = BoxSpec::new("upper", [1.0, 1.0, 0.5], [4, 4, 2]);
+        // outline points stay, interior lines move by 0.3 × 0.25
+        for (x, y) in [(0.0, 0.0), (1.0, 0.25), (0.5, 1.0), (0.0, 0.75)] {
+            let (px, py) = shift_and_turn(&b, 0.3, 15.0, x, y);
+            let moved_along = |v: f64, p: f64| if v > 0.0 && v < 1.0 { p - v - 0.075 } else { p - v };
+            // on the outline (ρ = 1) the turn is 0 and only the interior coordinate shifts
+            assert!(moved_along(x, px).abs() < 1e-12 && moved_along(y, py).abs() < 1e-12, "({x}, {y}) -> ({px}, {py})");
+        }
+        // (0.5, 0.25) is on an interior line in y: shifted to (0.575, 0.325), ρ = 0.35 ≤ ½: turned by θ
+        let (px, py) = shift_and_turn(&b, 0.3, 15.0, 0.5, 0.25);
+        let (dx, dy) = (0.075, -0.175);
+        let (sn, cs) = 15f64.to_radians().sin_cos();
+        assert!((px - (0.5 + cs * dx - sn * dy)).abs() < 1e-12 && (py - (0.5 + sn * dx + cs * dy)).abs() < 1e-12);
+    }
 }

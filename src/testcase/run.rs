@@ -15,17 +15,19 @@
 //!
 //! Error measures (all relative; the module docs of [`super`] give the frame):
 //! - patch: `stress_joint` = max over the elements whose centroid lies within one element layer
-//!   of the joint of max_ij |σ_ij − σ_ij exact| / s with s = max(p, |τ|); `szz_joint` the same for
-//!   σzz alone / p (the measure quoted for CalculiX); `stress_all` over every element;
-//!   `pressure` = max over slave nodes of |r_n − p A_s| / (s A_s) (`pressure_interior`: nodes
-//!   off the joint's perimeter); `shear` = max |r_t − τ A_s e_x| / (s A_s); `total` = Σ r_n /
-//!   (p A) − 1.
+//!   of the joint (of the cylinder of a curved joint) of max_ij |σ_ij − σ_ij exact| / s with s = max(p, |τ|); `szz_joint` the same for
+//!   σzz alone / p (the measure quoted for CalculiX; the headline of a flat pressure patch, of a
+//!   curved one `stress_joint`, as its σxx = −p too); `stress_all` over every element;
+//!   `pressure` = max over slave nodes of |r_n − r_n exact| / (s A_s), r_n exact = −n_s · σ V_s with
+//!   V_s = Σ_f n_f ∫ N_s dA the node's area vector (p A_s on a flat joint) (`pressure_interior`: nodes
+//!   off the joint's perimeter); `shear` = max |r_t − (σ V_s)_t| / (s A_s) (τ A_s e_x when flat);
+//!   `total` = Σ r_n / Σ r_n exact − 1.
 //! - slide: (s_FEM − s) / s with s_FEM the mean displacement of the slider's nodes down the
 //!   slope at the end.
 //! - impact: plateau mean, min and max of the contact force over 0.2–1.8 L/c / F − 1, and the
 //!   contact duration / (2L/c) − 1.
 
-use super::{Case, Kind, Reference, Side, BAR_L, BAR_V0, PATCH_SIDE};
+use super::{Case, Kind, Reference, BAR_L, BAR_V0, PATCH_SIDE};
 use crate::error::{CaseError, Error};
 use crate::problem::Problem;
 use crate::scene::Scene;
@@ -138,7 +140,7 @@ pub fn run_case(case: &Case) -> Result<CaseResult, Error> {
     let wall_time = t0.elapsed().as_secs_f64();
     let (error, error_of) = match &errors {
         Errors::Patch { szz_joint, stress_joint, .. } => {
-            if case.spec.pressure > 0.0 && case.spec.shear == 0.0 {
+            if case.spec.pressure > 0.0 && case.spec.shear == 0.0 && case.spec.curvature.is_none() {
                 (*szz_joint, "σzz next to the joint".to_string())
             } else {
                 (*stress_joint, "σ next to the joint".to_string())
@@ -171,7 +173,7 @@ fn measure_patch(case: &Case, sim: &Simulation<'_>, converged: bool, residual: f
     let pb = sim.problem;
     let model = &pb.model;
     let rot = r.rotation();
-    let exact = [0.0, 0.0, -r.pressure, 0.0, 0.0, r.shear];
+    let exact = super::patch_stress(r);
     let s_ref = r.pressure.max(r.shear.abs());
     let mut stress = Vec::new();
     model.element_stress_into(&sim.state.u, &mut stress);
@@ -180,7 +182,9 @@ fn measure_patch(case: &Case, sim: &Simulation<'_>, converged: bool, residual: f
     let (mut stress_joint, mut szz_joint, mut stress_all) = (0.0f64, 0.0f64, 0.0f64);
     for (e, (_, nodes)) in model.element_cells().iter().enumerate() {
         let c = nodes.iter().map(|&n| model.mesh.x(n as usize)).sum::<Vector3<f64>>() / nodes.len() as f64;
-        let z = (rot.transpose() * c)[2];
+        let cl = rot.transpose() * c;
+        // height above the joint surface (the cylinder of a curved joint)
+        let z = cl[2] - r.joint_height(cl[0]);
         let s = stress[e];
         let g = nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2]);
         let l = rot.transpose() * g * rot;
@@ -195,21 +199,23 @@ fn measure_patch(case: &Case, sim: &Simulation<'_>, converged: bool, residual: f
             }
         }
     }
-    // contact forces on the slave nodes: exact σ n_s A_s (n_s the slave's outward normal)
+    // contact forces on the slave nodes: exact σ · V_s, V_s = Σ_f n_f ∫ N_s dA the slave node's
+    // area vector (n_f out of the slave; = n_s A_s on a flat joint), normal part along the slave
+    // normal n_s (compression r_n = −n_s · σ V_s), tangential part the rest
     let joint = &pb.joints[0];
     let pairs = &sim.state.contact.joints[0].pairs;
-    let n_s = match r.slave {
-        Side::Upper => -Vector3::z(),
-        Side::Lower => Vector3::z(),
-    };
-    let sig = nalgebra::Matrix3::new(exact[0], exact[3], exact[5], exact[3], exact[1], exact[4], exact[5], exact[4], exact[2]);
-    let t_exact = sig * n_s;
-    let t_tangent = rot * (t_exact - n_s * n_s.dot(&t_exact));
-    let (mut pressure, mut pressure_interior, mut shear, mut total) = (0.0f64, 0.0f64, 0.0f64, 0.0);
+    let sig_g = rot * super::sym(&exact) * rot.transpose();
+    let mut vectors = vec![[0.0; 3]; joint.tag.slave.nodes.len()];
+    crate::interface::tributary_vectors_into(&joint.tag.slave, &mut vectors);
+    let (mut pressure, mut pressure_interior, mut shear, mut total, mut total_exact) = (0.0f64, 0.0f64, 0.0f64, 0.0, 0.0);
     for (i, p) in pairs.iter().enumerate() {
         let a = joint.tag.areas[i];
         let node = joint.tag.slave_nodes()[i];
-        let dp = (p.r_n - r.pressure * a).abs() / (s_ref * a);
+        let n_s = Vector3::from(joint.tag.normals[i]);
+        let f_exact = sig_g * Vector3::from(vectors[i]);
+        let rn_exact = -n_s.dot(&f_exact);
+        let t_exact = f_exact + n_s * rn_exact;
+        let dp = (p.r_n - rn_exact).abs() / (s_ref * a);
         pressure = pressure.max(dp);
         let x = rot.transpose() * model.mesh.x(node);
         let tol = 1e-9 * PATCH_SIDE;
@@ -218,11 +224,12 @@ fn measure_patch(case: &Case, sim: &Simulation<'_>, converged: bool, residual: f
         }
         let f = &joint.frames[i];
         let ft = f[1] * p.r_t[0] + f[2] * p.r_t[1];
-        shear = shear.max((ft - t_tangent * a).norm() / (s_ref * a));
+        shear = shear.max((ft - t_exact).norm() / (s_ref * a));
         total += p.r_n;
+        total_exact += rn_exact;
     }
     let area: f64 = joint.tag.areas.iter().sum();
-    let total = if r.pressure > 0.0 { total / (r.pressure * area) - 1.0 } else { total / (s_ref * area) };
+    let total = if r.pressure > 0.0 { total / total_exact - 1.0 } else { total / (s_ref * area) };
     Errors::Patch { stress_joint, szz_joint, stress_all, pressure, pressure_interior, shear, total, converged, residual }
 }
 

@@ -16,8 +16,11 @@ fn case(v: serde_json::Value) -> CaseResult {
     println!("{v}: error {:.4e} ({}), {:?}, lost {}", r.error, r.error_of, r.errors, r.lost);
     if let Errors::Patch { converged, residual, total, .. } = &r.errors {
         assert!(*converged && *residual < 1e-10, "{v}: static solve not converged ({residual:.2e})");
-        // global equilibrium of the joint: Σ r_n = p A (or ≈ 0 in pure shear, relative to τ A)
-        assert!(total.abs() < 1e-6, "{v}: Σ r_n off by {total:.2e}");
+        // global equilibrium of a flat joint: Σ r_n = p A (or ≈ 0 in pure shear, relative to τ A);
+        // on a curved joint Σ r_n also depends on how the force splits into normal and shear
+        if v.get("curvature").is_none() {
+            assert!(total.abs() < 1e-6, "{v}: Σ r_n off by {total:.2e}");
+        }
     }
     r
 }
@@ -75,6 +78,58 @@ fn tet_over_hex_patch_within_measured_bounds() {
     assert!(r.error < 0.28, "tet4 4×4 on hex 3×3: σzz {:.4}", r.error);
     let r = case(json!({"kind": "patch", "lower": "tet4:3", "upper": "hex8:3", "slave": "lower"}));
     assert!(r.error < 0.23 && r.error > 0.05, "tet4 3×3 on hex 3×3: σzz {:.4}", r.error);
+}
+
+/// Mixed blocks (hex8 in the first ⌈N/2⌉ columns, Kuhn tets in the rest, one block; the joint
+/// face half quads, half triangles). Reference: the uniform state, exact on conforming joints.
+/// Measured: mixed 3×3 on mixed 3×3 (conforming, so the hex–tet faces inside each block are
+/// exercised alone) σ 6.2e-10, bound 1e-8; mixed 4×4 slave on hex 3×3, NTS σzz 18.5 % (bound
+/// 0.23), between hex/hex (8.40 %) and tet/hex (22.3 %) on the same grids.
+#[test]
+fn mixed_hex_tet_block_patch_within_measured_bounds() {
+    let r = case(json!({"kind": "patch", "lower": "mixed:3", "upper": "mixed:3"}));
+    let (s, p, _) = patch_errors(&r);
+    assert!(s < 1e-8 && p < 1e-8, "conforming mixed patch: σ {s:.2e}, pressure {p:.2e}");
+    let r = case(json!({"kind": "patch", "lower": "mixed:4", "upper": "hex8:3", "slave": "lower"}));
+    assert!(r.error < 0.23 && r.error > 0.05, "mixed 4×4 on hex 3×3: σzz {:.4}", r.error);
+}
+
+/// Node alignment broken on equal meshes: the upper 3×3 hex side shifted by 0.3 of an element
+/// (interior grid lines) or turned by 15° about the joint normal (inner half rigid), slave upper.
+/// Reference: the uniform state (outline unchanged, so it is still exact). Measured: shift, NTS
+/// σzz 19.6 % (bound 0.245), NTN 58.2 % (larger than NTS); turn, NTS 10.6 % (bound 0.13).
+#[test]
+fn offset_and_turned_meshes_within_measured_bounds() {
+    let nts = case(json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "offset": 0.3}));
+    let ntn = case(json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "offset": 0.3, "method": "ntn"}));
+    assert!(nts.error < 0.245 && nts.error > 0.05, "offset 0.3 NTS σzz {:.4}", nts.error);
+    assert!(ntn.error > nts.error, "offset 0.3: NTN {:.4} vs NTS {:.4}", ntn.error, nts.error);
+    let r = case(json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "rotate": 15.0}));
+    assert!(r.error < 0.13 && r.error > 0.02, "turned 15° NTS σzz {:.4}", r.error);
+}
+
+/// Cylindrical joints (radius R = 1 m, axis along y: the lower block bulges 0.134 m into the
+/// upper; slave nodes placed on the master's facets). Reference: the uniform σzz = −p, exactly
+/// linear, so exact on conforming meshes whatever the shape; on the cylinder it is a normal
+/// and a shear traction (σ n = −p n_z e_z), held by friction. Measured on the conforming hex
+/// 3×3 joint: NTN 1.3e-10 (bound 1e-8), NTS 0.521 % (bound 0.0065; it falls as about 1/R²:
+/// 0.146 % at R = 2 m, 0.031 % at 5 m, so it is the facet kink, 19° here, not the mesh
+/// ratio); hex 4×4 slave on 3×3: NTS σ 8.28 % (bound 0.105), NTN 74.5 % (larger).
+#[test]
+fn cylindrical_joint_patch_within_measured_bounds() {
+    let conf = json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "curvature": 1.0});
+    let mut ntn = conf.clone();
+    ntn["method"] = json!("ntn");
+    let r = case(ntn);
+    assert!(r.error < 1e-8, "conforming cylinder NTN σ {:.3e}", r.error);
+    let r = case(conf);
+    assert!(r.error < 0.0065, "conforming cylinder NTS σ {:.4e}", r.error);
+    let fine = json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "curvature": 1.0});
+    let nts = case(fine.clone());
+    let mut n = fine;
+    n["method"] = json!("ntn");
+    let ntn = case(n);
+    assert!(nts.error < 0.105 && ntn.error > nts.error, "cylinder 4×4 on 3×3: NTS {:.4}, NTN {:.4}", nts.error, ntn.error);
 }
 
 /// Issue 13 §3: a tied NTS interface between non-conforming meshes (hex 4×4 slave on 3×3)
@@ -148,6 +203,12 @@ fn bad_testcase_options_are_named() {
     let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "shear": 7e5})).unwrap();
     let e = build(&spec).err().expect("τ ≥ μ p is refused").to_string();
     assert!(e.contains("`shear`") && e.contains("tied"), "{e}");
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "curvature": 0.6, "mu": 0.3})).unwrap();
+    let e = build(&spec).err().expect("μ below the cylinder's slope is refused").to_string();
+    assert!(e.contains("`curvature`") && e.contains("slope"), "{e}");
+    let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "upper": "hex8:10", "rotate": 45.0})).unwrap();
+    let e = build(&spec).err().expect("an inverted element is refused").to_string();
+    assert!(e.contains("`rotate`") && e.contains("inside out"), "{e}");
     let spec: CaseSpec = serde_json::from_value(json!({"kind": "slide", "slave": "lower"})).unwrap();
     assert!(build(&spec).err().unwrap().to_string().contains("`slave`"));
     let spec: CaseSpec = serde_json::from_value(json!({"kind": "patch", "lower": "hex8:200:200", "upper": "hex8:200:200"})).unwrap();
