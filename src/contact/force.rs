@@ -17,9 +17,19 @@
 //!    moved since their last evaluation (they would give the same force); before, it takes them
 //!    all without the bookkeeping.
 //!
-//! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 for a node with any fixed component (a fixed
-//! node does not move under contact forces; free components of partly fixed nodes are treated
-//! as fixed for the pair mobility, and the correction is applied to free components only).
+//! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 at a fully fixed node (it does not move under
+//! contact forces). **Partly fixed nodes** (a symmetry plane, a roller: some components fixed)
+//! take the pair force on their free components only: a node moves by (dt²/m) P r, P the
+//! projection on its free components, and the support takes the rest. The pair's mobility is
+//! then the diagonal matrix W = Σ c_b² P_b / m_b (global axes), no longer w I; the pair update
+//! keeps its scalar form with w = the largest diagonal entry of W (its largest eigenvalue),
+//! which the Gauss–Seidel sweeps iterate to the exact fixed point (the update is in residual
+//! form: the gap and the stick motion it leaves are those of the actual masked displacements,
+//! and a scalar at or above W's spectrum converges monotonically; exact in one update when
+//! the normal and the slip direction are free at every node, as on a symmetry plane that the
+//! joint crosses at right angles). A pair whose normal is fixed at every node (nᵀ W n = 0)
+//! takes no force. Models without partly fixed nodes never enter this path (docs/contact.md,
+//! "Partly fixed nodes").
 //!
 //! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal spring
 //! kn A on the gap, tangential elastic spring kt A, with the joint law of the dynamic contact
@@ -99,6 +109,9 @@ struct Active {
     mob: [f64; 5],
     /// The largest mob² of the five (a full sweep's test of whether the pair moved a node).
     mob2_max: f64,
+    /// A pair with a partly fixed node: its nodes move by `mob_masked` (per node, `mob` times
+    /// the node's free components), not by `mob` (module doc, "Partly fixed nodes").
+    partial: bool,
     /// The same five nodes as indices into the solver's local nodes ([`LocalNode`]).
     local: [u32; 5],
 }
@@ -116,11 +129,18 @@ impl Active {
     }
 
     /// Move the pair's local nodes by the displacements a pair force `r` (N, on the slave) makes
-    /// over one step (`mob`: 0 at a fixed node or an unused entry).
+    /// over one step (`mob`: 0 at a fixed node or an unused entry; `masked`: this pair's
+    /// per-component mobilities when it has a partly fixed node).
     #[inline(always)]
-    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>) {
-        for b in 0..5 {
-            local[self.local[b] as usize].x += r * self.mob[b];
+    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>, masked: &[[Vector3<f64>; 5]], k: usize) {
+        if self.partial {
+            for b in 0..5 {
+                local[self.local[b] as usize].x += r.component_mul(&masked[k][b]);
+            }
+        } else {
+            for b in 0..5 {
+                local[self.local[b] as usize].x += r * self.mob[b];
+            }
         }
     }
 }
@@ -174,9 +194,16 @@ pub struct ContactSolver<'m> {
     /// The Gauss–Seidel order of the active pairs (indices into `active`).
     order: Vec<u32>,
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
-    /// Per node 1/m for the pair mobilities (0 at a node with a fixed component or without
-    /// inertia; at a block node its largest inverse mass).
+    /// Per node 1/m for the pair mobilities (0 at a fully fixed node or one without inertia; at
+    /// a block node its largest inverse mass; a partly fixed node has its 1/m, applied to its
+    /// free components only).
     inv_mass: Vec<f64>,
+    /// The partly fixed nodes with inertia (some but not all components fixed), ascending;
+    /// empty for most models, which then never test for them.
+    partial: Vec<u32>,
+    /// Per active pair when `partial` is not empty (else empty): its nodes' mobilities per
+    /// component (`mob` times each node's free components, 1 or 0).
+    mob_masked: Vec<[Vector3<f64>; 5]>,
     /// The free nodes with a 3×3 inertia block, ascending (empty for most models).
     block_nodes: Vec<u32>,
     cand: Vec<u32>,
@@ -198,17 +225,25 @@ impl<'m> ContactSolver<'m> {
     pub fn new(model: &Model, joints: &'m [ContactJoint]) -> ContactSolver<'m> {
         let size = joints.iter().map(|j| j.tag.size).fold(0.0, f64::max);
         let mass = &model.mass;
-        let mut inv_mass: Vec<f64> = (0..model.n_nodes())
-            .map(|n| if model.fixed[n] == 0 && mass.inertial[n] > 0.0 { 1.0 / mass.inertial[n] } else { 0.0 })
-            .collect();
+        // a node with a free component moves under contact forces (on its free components)
+        let movable = |n: usize| model.fixed[n] != ALL_FIXED;
+        let mut inv_mass: Vec<f64> = (0..model.n_nodes()).map(|n| if movable(n) && mass.inertial[n] > 0.0 { 1.0 / mass.inertial[n] } else { 0.0 }).collect();
         // a block node: its largest inverse mass (for the penalty bound and the colouring's
-        // test of a moving node); the pairs read it along their normal (`inverse_mass_along`)
-        let block_nodes: Vec<u32> = mass.blocks.iter().filter(|b| model.fixed[b.node as usize] == 0).map(|b| b.node).collect();
+        // test of a moving node); the pairs read it along their normal (`inverse_mass_along`;
+        // the block's inverse is already restricted to the free components)
+        let block_nodes: Vec<u32> = mass.blocks.iter().filter(|b| movable(b.node as usize)).map(|b| b.node).collect();
         for b in &mass.blocks {
             let n = b.node as usize;
-            inv_mass[n] = if model.fixed[n] == 0 { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
+            inv_mass[n] = if movable(n) { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
         }
-        ContactSolver { block_nodes, joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
+        ContactSolver { block_nodes, partial, mob_masked: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+    }
+
+    /// Whether `node` is partly fixed (and moves on its free components only).
+    #[inline]
+    fn is_partial(&self, node: u32) -> bool {
+        !self.partial.is_empty() && self.partial.binary_search(&node).is_ok()
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -305,6 +340,15 @@ impl<'m> ContactSolver<'m> {
             self.cand.dedup();
         }
     }
+}
+
+/// `Model::fixed` of a node with all three components fixed.
+const ALL_FIXED: u8 = 7;
+
+/// A node's free components as a mask (1 free, 0 fixed).
+#[inline]
+fn free_mask(model: &Model, node: usize) -> Vector3<f64> {
+    Vector3::from_fn(|c, _| if model.is_free(node, c) { 1.0 } else { 0.0 })
 }
 
 #[inline]
@@ -463,7 +507,7 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
 /// loop rather than a test per pair, so that the full pass carries nothing of the list.
 #[inline(never)] // its own code, whatever the code around it (a sweep is long; one call per sweep)
 #[allow(clippy::too_many_arguments)]
-fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64) -> usize {
+fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_masked: &[[Vector3<f64>; 5]]) -> usize {
     let mut moving = 0;
     for &k in order.iter() {
         let k = k as usize;
@@ -497,11 +541,15 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
             for b in 0..5 {
                 let l = &mut local[a.local[b] as usize];
                 l.moved_at = l.moved_at.max(*clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
-                l.x += dr * a.mob[b];
+                if a.partial {
+                    l.x += dr.component_mul(&mob_masked[k][b]);
+                } else {
+                    l.x += dr * a.mob[b];
+                }
             }
         } else {
             moving += (dr2 * a.mob2_max > mark_tol2) as usize;
-            a.move_nodes_into(local, &dr);
+            a.move_nodes_into(local, &dr, mob_masked, k);
         }
         let e = &mut active[k];
         e.gap = g_trial + e.dt2w * resp.r_n;
@@ -526,6 +574,7 @@ impl ContactSolver<'_> {
     #[inline(never)] // out of line, so that profiles show the four parts of a step
     fn search_into(&mut self, model: &Model, history: &mut ContactState, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> f64 {
         self.active.clear();
+        self.mob_masked.clear();
         self.penalty.clear();
         let mut penalty_work = 0.0;
         // ---------------------------------------------------------------- search
@@ -672,6 +721,23 @@ impl ContactSolver<'_> {
                     imm[a] = self.inverse_mass_along(model, masters[a] as usize, &n);
                     w += weights[a] * weights[a] * imm[a];
                 }
+                // a partly fixed node in the pair: the mobility per component, W = Σ c² P / m
+                // (diagonal); the update's scalar is its largest entry (module doc)
+                let partial = !self.partial.is_empty() && (self.is_partial(s as u32) || masters[..nm as usize].iter().any(|&m| self.is_partial(m)));
+                let mut masks = [Vector3::repeat(1.0); 5];
+                if partial {
+                    masks[0] = free_mask(model, s);
+                    let mut wv = masks[0] * ims;
+                    for a in 0..nm as usize {
+                        masks[a + 1] = free_mask(model, masters[a] as usize);
+                        wv += masks[a + 1] * (weights[a] * weights[a] * imm[a]);
+                    }
+                    if wv.dot(&n.component_mul(&n)) == 0.0 {
+                        // no node of the pair can move along its normal: no contact force
+                        continue;
+                    }
+                    w = wv.max();
+                }
                 if w == 0.0 {
                     continue;
                 }
@@ -731,9 +797,14 @@ impl ContactSolver<'_> {
                         mob[b + 1] = -dt2 * weights[b] * imi;
                     }
                 }
+                if !self.partial.is_empty() {
+                    // one entry per active pair (indexed like `active`), read when `partial`
+                    self.mob_masked.push(std::array::from_fn(|b| masks[b] * mob[b]));
+                }
                 self.active.push(Active {
                     nodes: nodes5,
                     local: [0; 5],
+                    partial,
                     mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
                     coef,
                     mob,
@@ -780,6 +851,18 @@ impl ContactSolver<'_> {
                 }
             }
         }
+        if !self.partial.is_empty() && !self.penalty.is_empty() {
+            // a partly fixed node takes a penalty force on its free components only: its fixed
+            // ones stay at the prediction's 0 (`Model::held`)
+            for &nd in &self.partial {
+                let nd = nd as usize;
+                for c in 0..3 {
+                    if !model.is_free(nd, c) {
+                        u_next[3 * nd + c] = 0.0;
+                    }
+                }
+            }
+        }
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             let s = s as usize;
             let mut du = (disp(u_next, s) - disp(u_prev, s)) * 0.5;
@@ -803,8 +886,8 @@ impl ContactSolver<'_> {
         self.step_clock += 1;
         self.local.clear();
         self.local_global.clear();
-        let ContactSolver { active, node, local, local_global, step_clock, .. } = self;
-        for a in active.iter_mut() {
+        let ContactSolver { active, node, local, local_global, step_clock, mob_masked, .. } = self;
+        for (k, a) in active.iter_mut().enumerate() {
             // the pair's nodes among the local nodes, copied from the prediction when first met
             for b in 0..5 {
                 let nd = a.nodes[b] as usize;
@@ -823,7 +906,7 @@ impl ContactSolver<'_> {
             if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
                 let [n, t1, t2] = a.frame;
                 let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                a.move_nodes_into(local, &r);
+                a.move_nodes_into(local, &r, mob_masked, k);
             }
         }
         if self.gs_colored {
@@ -848,7 +931,7 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
+        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_masked, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
         for (x0, l) in sweep_start.iter_mut().zip(local.iter()) {
@@ -872,9 +955,9 @@ impl ContactSolver<'_> {
                 local.iter_mut().for_each(|l| l.moved_at = clock);
             }
             moving = if listed {
-                sweep_pass::<true>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
+                sweep_pass::<true>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_masked)
             } else {
-                sweep_pass::<false>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
+                sweep_pass::<false>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_masked)
             };
             let max_du = sweep_change_into(local, sweep_start).sqrt();
             residual = max_du;
