@@ -342,6 +342,14 @@ impl<'m> ContactSolver<'m> {
     }
 }
 
+/// Updates in a row of a pair with a partly fixed node within one sweep (stopping early once an
+/// update moves no node by more than the marking tolerance): 8. Its scalar mobility is the
+/// largest of its directions' (module doc), so when the normal or the slip direction is at an
+/// angle to the free components one update leaves part of the pair's own residual; repeating
+/// it costs nothing elsewhere (other pairs update once). Measured on the slide case with its
+/// slave face fixed in x (docs/contact.md, "Partly fixed nodes").
+const PARTIAL_PAIR_UPDATES: usize = 8;
+
 /// `Model::fixed` of a node with all three components fixed.
 const ALL_FIXED: u8 = 7;
 
@@ -519,44 +527,56 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
             *clock += 1;
             evaluated_at[k] = *clock;
         }
-        let [n, t1, t2] = a.frame;
-        // current relative quantities with all forces applied so far
-        let rel = a.relative_displacement(local);
-        let g_cur = a.gap0 + n.dot(&rel);
-        let dd = a.rel_u - rel;
-        // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
-        let g_trial = g_cur - a.dt2w * a.r_n;
-        let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-        let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
-        let d_rn = resp.r_n - a.r_n;
-        let d_rt = resp.r_t - a.r_t;
-        // move the nodes by the force change (a fixed node or an unused entry has
-        // mobility 0 and does not move); the pairs on a node moved by more than the
-        // marking tolerance must be evaluated again (the clock only grows, so the max
-        // marks without a branch)
-        let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
-        // |du|² = |dr|² mob²: one norm per pair instead of one per node
-        let dr2 = dr.norm_squared();
-        if LISTED {
-            for b in 0..5 {
-                let l = &mut local[a.local[b] as usize];
-                l.moved_at = l.moved_at.max(*clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
-                if a.partial {
-                    l.x += dr.component_mul(&mob_masked[k][b]);
-                } else {
-                    l.x += dr * a.mob[b];
+        // a pair with a partly fixed node repeats its update (its scalar mobility is an upper
+        // bound of its directions', so one update may leave part of its own residual:
+        // `PARTIAL_PAIR_UPDATES`); every other pair updates once
+        let reps = if a.partial { PARTIAL_PAIR_UPDATES } else { 1 };
+        for rep in 0..reps {
+            let a = &active[k];
+            let [n, t1, t2] = a.frame;
+            // current relative quantities with all forces applied so far
+            let rel = a.relative_displacement(local);
+            let g_cur = a.gap0 + n.dot(&rel);
+            let dd = a.rel_u - rel;
+            // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
+            let g_trial = g_cur - a.dt2w * a.r_n;
+            let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
+            let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
+            let d_rn = resp.r_n - a.r_n;
+            let d_rt = resp.r_t - a.r_t;
+            // move the nodes by the force change (a fixed node or an unused entry has
+            // mobility 0 and does not move); the pairs on a node moved by more than the
+            // marking tolerance must be evaluated again (the clock only grows, so the max
+            // marks without a branch)
+            let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
+            // |du|² = |dr|² mob²: one norm per pair instead of one per node
+            let dr2 = dr.norm_squared();
+            if LISTED {
+                for b in 0..5 {
+                    let l = &mut local[a.local[b] as usize];
+                    l.moved_at = l.moved_at.max(*clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
+                    if a.partial {
+                        l.x += dr.component_mul(&mob_masked[k][b]);
+                    } else {
+                        l.x += dr * a.mob[b];
+                    }
                 }
+            } else {
+                if rep == 0 {
+                    moving += (dr2 * a.mob2_max > mark_tol2) as usize;
+                }
+                a.move_nodes_into(local, &dr, mob_masked, k);
             }
-        } else {
-            moving += (dr2 * a.mob2_max > mark_tol2) as usize;
-            a.move_nodes_into(local, &dr, mob_masked, k);
+            let e = &mut active[k];
+            e.gap = g_trial + e.dt2w * resp.r_n;
+            e.r_n = resp.r_n;
+            e.r_t = resp.r_t;
+            e.hist = resp.hist;
+            e.state = resp.state;
+            if dr2 * e.mob2_max <= mark_tol2 {
+                break;
+            }
         }
-        let e = &mut active[k];
-        e.gap = g_trial + e.dt2w * resp.r_n;
-        e.r_n = resp.r_n;
-        e.r_t = resp.r_t;
-        e.hist = resp.hist;
-        e.state = resp.state;
     }
     moving
 }
