@@ -848,4 +848,11 @@ fn sliver_setting_the_stable_step_is_named_with_its_quality() {
     }
     let text = bad.to_text();
     assert!(text.contains(&format!("scaled Jacobian {q:.3}")) && text.contains("WARNING") && text.contains("sliver"), "{text}");
+    // a run refused for its step count says so up front too
+    let dir = scratch("outputs/quality_max_steps");
+    let mut sc = boxes_tet_scene("sliver_tet.msh");
+    sc["time"]["max_steps"] = json!(1);
+    let p = write_scene(&dir, &sc);
+    let e = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).err().expect("refused").to_string();
+    assert!(e.contains(&format!("element {}", bad.critical_element)) && e.contains(&format!("scaled Jacobian {q:.3}")) && e.contains("a sliver"), "{e}");
 }
