@@ -527,58 +527,77 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
             *clock += 1;
             evaluated_at[k] = *clock;
         }
-        // a pair with a partly fixed node repeats its update (its scalar mobility is an upper
-        // bound of its directions', so one update may leave part of its own residual:
-        // `PARTIAL_PAIR_UPDATES`); every other pair updates once
-        let reps = if a.partial { PARTIAL_PAIR_UPDATES } else { 1 };
-        for rep in 0..reps {
-            let a = &active[k];
-            let [n, t1, t2] = a.frame;
-            // current relative quantities with all forces applied so far
-            let rel = a.relative_displacement(local);
-            let g_cur = a.gap0 + n.dot(&rel);
-            let dd = a.rel_u - rel;
-            // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
-            let g_trial = g_cur - a.dt2w * a.r_n;
-            let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-            let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
-            let d_rn = resp.r_n - a.r_n;
-            let d_rt = resp.r_t - a.r_t;
-            // move the nodes by the force change (a fixed node or an unused entry has
-            // mobility 0 and does not move); the pairs on a node moved by more than the
-            // marking tolerance must be evaluated again (the clock only grows, so the max
-            // marks without a branch)
-            let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
-            // |du|² = |dr|² mob²: one norm per pair instead of one per node
-            let dr2 = dr.norm_squared();
-            if LISTED {
-                for b in 0..5 {
-                    let l = &mut local[a.local[b] as usize];
-                    l.moved_at = l.moved_at.max(*clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
-                    if a.partial {
-                        l.x += dr.component_mul(&mob_masked[k][b]);
-                    } else {
-                        l.x += dr * a.mob[b];
+        if a.partial {
+            // a pair with a partly fixed node repeats its update (its scalar mobility is an
+            // upper bound of its directions', so one update may leave part of its own
+            // residual: `PARTIAL_PAIR_UPDATES`), until an update moves no node
+            let moved = update_pair::<LISTED, true>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_masked);
+            moving += moved as usize;
+            if moved {
+                for _ in 1..PARTIAL_PAIR_UPDATES {
+                    if !update_pair::<LISTED, true>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_masked) {
+                        break;
                     }
                 }
-            } else {
-                if rep == 0 {
-                    moving += (dr2 * a.mob2_max > mark_tol2) as usize;
-                }
-                a.move_nodes_into(local, &dr, mob_masked, k);
             }
-            let e = &mut active[k];
-            e.gap = g_trial + e.dt2w * resp.r_n;
-            e.r_n = resp.r_n;
-            e.r_t = resp.r_t;
-            e.hist = resp.hist;
-            e.state = resp.state;
-            if dr2 * e.mob2_max <= mark_tol2 {
-                break;
-            }
+        } else {
+            moving += update_pair::<LISTED, false>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_masked) as usize;
         }
     }
-    moving
+    if LISTED { 0 } else { moving }
+}
+
+/// One update of active pair `a` (index `k`) in a sweep: its force from the current positions
+/// of its local nodes with its own force removed, the nodes moved by the change, and with
+/// `LISTED` the nodes it moves by more than the marking tolerance stamped at `clock`. `PARTIAL`:
+/// the pair has a partly fixed node and moves its nodes by `mob_masked[k]`. Returns whether the
+/// update moved a node by more than the marking tolerance.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn update_pair<const LISTED: bool, const PARTIAL: bool>(a: &mut Active, k: usize, local: &mut [LocalNode], clock: u32, laws: &[JointLaw], mark_tol2: f64, mob_masked: &[[Vector3<f64>; 5]]) -> bool {
+    let [n, t1, t2] = a.frame;
+    // current relative quantities with all forces applied so far
+    let rel = a.relative_displacement(local);
+    let g_cur = a.gap0 + n.dot(&rel);
+    let dd = a.rel_u - rel;
+    // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
+    let g_trial = g_cur - a.dt2w * a.r_n;
+    let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
+    let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
+    let d_rn = resp.r_n - a.r_n;
+    let d_rt = resp.r_t - a.r_t;
+    // move the nodes by the force change (a fixed node or an unused entry has
+    // mobility 0 and does not move); the pairs on a node moved by more than the
+    // marking tolerance must be evaluated again (the clock only grows, so the max
+    // marks without a branch)
+    let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
+    // |du|² = |dr|² mob²: one norm per pair instead of one per node
+    let dr2 = dr.norm_squared();
+    if LISTED {
+        for b in 0..5 {
+            let l = &mut local[a.local[b] as usize];
+            l.moved_at = l.moved_at.max(clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
+            if PARTIAL {
+                l.x += dr.component_mul(&mob_masked[k][b]);
+            } else {
+                l.x += dr * a.mob[b];
+            }
+        }
+    } else if PARTIAL {
+        for b in 0..5 {
+            local[a.local[b] as usize].x += dr.component_mul(&mob_masked[k][b]);
+        }
+    } else {
+        for b in 0..5 {
+            local[a.local[b] as usize].x += dr * a.mob[b];
+        }
+    }
+    a.gap = g_trial + a.dt2w * resp.r_n;
+    a.r_n = resp.r_n;
+    a.r_t = resp.r_t;
+    a.hist = resp.hist;
+    a.state = resp.state;
+    dr2 * a.mob2_max > mark_tol2
 }
 
 /// Whether active pair `a`, last evaluated at tick `since`, has a node moved after it.
