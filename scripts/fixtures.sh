@@ -7,7 +7,7 @@
 # GMSH:   the gmsh command, split on spaces (default: the venv python running the venv's
 #         gmsh script, "<repo>/.venv/bin/python <repo>/.venv/bin/gmsh"; the wheel's script
 #         must be run with the venv python).
-# PYTHON: a python3 for the one post-processing step, inverted_tet.msh (standard library
+# PYTHON: a python3 for the post-processing steps, inverted_tet.msh and sliver_tet.msh (standard library
 #         only; default: <repo>/.venv/bin/python if it exists, else python3).
 #
 # Each fixture, its parameters and groups are listed in tests/fixtures/README.md; keep it
@@ -104,4 +104,25 @@ while i < b:
 else:
     sys.exit("fixtures.sh: no tet4 block for block:upper in " + src)
 open(dst, "w").write("\n".join(lines))
+PY
+
+# sliver_tet.msh: boxes_tet.msh with the top corner node (1, 1, 0.5) of block:upper moved down
+# to z = 0.27 (0.23 m of its 0.25 m layer): one tet4 under it is flattened to a sliver (scaled
+# Jacobian 0.04), none inverted. The stable step's critical element (tests/all/outputs.rs).
+"$PYTHON" - "$out/boxes_tet.msh" "$out/sliver_tet.msh" <<'PY'
+import sys
+
+src, dst = sys.argv[1], sys.argv[2]
+lines = open(src).read().split("\n")
+a, b = lines.index("$Nodes") + 1, lines.index("$EndNodes")
+moved = 0
+for i in range(a, b):
+    f = lines[i].split()
+    if len(f) == 3 and all(abs(float(x) - y) < 1e-9 for x, y in zip(f, (1.0, 1.0, 0.5))):
+        lines[i] = f"{f[0]} {f[1]} 0.27"
+        moved += 1
+if moved != 1:
+    sys.exit(f"fixtures.sh: {moved} nodes at (1, 1, 0.5) in {src}, expected 1")
+open(dst, "w").write("\n".join(lines))
+print(f"{'sliver_tet.msh':<28s} node (1, 1, 0.5) of block:upper moved to z = 0.27")
 PY

@@ -196,7 +196,7 @@ pub struct TagSummary {
 /// diagonal), and write `<out>/tagging/joints.json`, one `<out>/tagging/<joint>.vtu` per joint and
 /// `<out>/tagging/summary.json`. `<out>` is `opts.out_dir`, else the scene's output directory.
 pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
-    use crate::interface::{tag_joint, write_joint_json, write_joint_vtu, JointSpec};
+    use crate::interface::{tag_joint_in, write_joint_json, write_joint_vtu, JointSpec};
     let t_all = Instant::now();
     let mut scene = Scene::load(scene_path)?;
     if scene.joints.is_empty() {
@@ -215,6 +215,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
     let dir = out_dir.join("tagging");
     std::fs::create_dir_all(&dir).map_err(|e| crate::error::OutputError::write(&dir, e))?;
 
+    let blocks = crate::mesh::topology::Blocks::of(&mesh);
     let mut joints = Vec::with_capacity(scene.joints.len());
     let mut rows = Vec::with_capacity(scene.joints.len());
     let stems: Vec<String> = scene.joints.iter().map(|j| crate::scene::joint_file_stem(&j.name)).collect();
@@ -224,7 +225,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
             Some(t) => (t, "scene"),
             None => (DEFAULT_JOINT_TOLERANCE_RELATIVE * model_size, "default"),
         };
-        let joint = tag_joint(&mesh, &spec, tolerance)?;
+        let joint = tag_joint_in(&mesh, &blocks, &spec, tolerance)?;
         let vtu = dir.join(format!("{stem}.vtu"));
         write_joint_vtu(&vtu, &mesh, &joint)?;
         let n = joint.n_slave().max(1) as f64;

@@ -17,9 +17,19 @@
 //!    moved since their last evaluation (they would give the same force); before, it takes them
 //!    all without the bookkeeping.
 //!
-//! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 for a node with any fixed component (a fixed
-//! node does not move under contact forces; free components of partly fixed nodes are treated
-//! as fixed for the pair mobility, and the correction is applied to free components only).
+//! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 at a fully fixed node (it does not move under
+//! contact forces). **Partly fixed nodes** (a symmetry plane, a roller: some components fixed)
+//! take the pair force on their free components only: a node moves by (dt²/m) P r, P the
+//! projection on its free components, and the support takes the rest. The pair's mobility is
+//! then the diagonal matrix W = Σ c_b² P_b / m_b (global axes), no longer w I; the pair update
+//! keeps its scalar form with w = the largest diagonal entry of W (its largest eigenvalue),
+//! which the Gauss–Seidel sweeps iterate to the exact fixed point (the update is in residual
+//! form: the gap and the stick motion it leaves are those of the actual masked displacements,
+//! and a scalar at or above W's spectrum converges monotonically; exact in one update when
+//! the normal and the slip direction are free at every node, as on a symmetry plane that the
+//! joint crosses at right angles). A pair whose normal is fixed at every node (nᵀ W n = 0)
+//! takes no force. Models without partly fixed nodes never enter this path (docs/contact.md,
+//! "Partly fixed nodes").
 //!
 //! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal spring
 //! kn A on the gap, tangential elastic spring kt A, with the joint law of the dynamic contact
@@ -99,15 +109,14 @@ struct Active {
     mob: [f64; 5],
     /// The largest mob² of the five (a full sweep's test of whether the pair moved a node).
     mob2_max: f64,
+    /// A pair with a partly fixed node or a node with an inertia block: its nodes move by
+    /// `mob_matrix` (per node, `mob` times the node's free components, or its block's
+    /// inverse), not by `mob` (module doc, "Partly fixed nodes"; docs/contact.md, "Mobility of
+    /// an anisotropic mass").
+    partial: bool,
     /// The same five nodes as indices into the solver's local nodes ([`LocalNode`]).
     local: [u32; 5],
-    /// [`NO_ANISO`], or the index of the pair's five move matrices in
-    /// `ContactSolver::aniso` when one of its nodes has an inertia block.
-    aniso: u32,
 }
-
-/// `Active::aniso` of a pair with no inertia-block node (its moves are `mob` × the force).
-const NO_ANISO: u32 = u32::MAX;
 
 impl Active {
     /// The pair's relative displacement Σ N_I x_I − x_s over the local nodes (five terms
@@ -122,17 +131,17 @@ impl Active {
     }
 
     /// Move the pair's local nodes by the displacements a pair force `r` (N, on the slave) makes
-    /// over one step (`mob`: 0 at a fixed node or an unused entry).
+    /// over one step (`mob`: 0 at a fixed node or an unused entry; `masked`: this pair's
+    /// per-component mobilities when it has a partly fixed node).
     #[inline(always)]
-    fn move_nodes_into(&self, local: &mut [LocalNode], aniso: &[[Matrix3<f64>; 5]], r: &Vector3<f64>) {
-        if self.aniso == NO_ANISO {
+    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>, matrix: &[[Matrix3<f64>; 5]], k: usize) {
+        if self.partial {
             for b in 0..5 {
-                local[self.local[b] as usize].x += r * self.mob[b];
+                local[self.local[b] as usize].x += matrix[k][b] * r;
             }
         } else {
-            let m = &aniso[self.aniso as usize];
             for b in 0..5 {
-                local[self.local[b] as usize].x += m[b] * r;
+                local[self.local[b] as usize].x += r * self.mob[b];
             }
         }
     }
@@ -187,9 +196,16 @@ pub struct ContactSolver<'m> {
     /// The Gauss–Seidel order of the active pairs (indices into `active`).
     order: Vec<u32>,
     penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
-    /// Per node 1/m for the pair mobilities (0 at a node with a fixed component or without
-    /// inertia; at a block node its largest inverse mass).
+    /// Per node 1/m for the pair mobilities (0 at a fully fixed node or one without inertia; at
+    /// a block node its largest inverse mass; a partly fixed node has its 1/m, applied to its
+    /// free components only).
     inv_mass: Vec<f64>,
+    /// The partly fixed nodes with inertia (some but not all components fixed), ascending;
+    /// empty for most models, which then never test for them.
+    partial: Vec<u32>,
+    /// Per active pair when `partial` is not empty (else empty): its nodes' mobilities per
+    /// component (`mob` times each node's free components, 1 or 0).
+    mob_matrix: Vec<[Matrix3<f64>; 5]>,
     /// The free nodes with a 3×3 inertia block, ascending (empty for most models).
     block_nodes: Vec<u32>,
     cand: Vec<u32>,
@@ -204,9 +220,6 @@ pub struct ContactSolver<'m> {
     /// (the convergence test takes the net change of each node over a sweep).
     local: Vec<LocalNode>,
     local_global: Vec<u32>,
-    /// Per step: the five move matrices dt² M⁻¹ (slave) and −dt² N_I M_I⁻¹ (masters) of each
-    /// active pair that has a node with an inertia block ([`Active::aniso`]).
-    aniso: Vec<[Matrix3<f64>; 5]>,
     sweep_start: Vec<Vector3<f64>>,
 }
 
@@ -214,17 +227,26 @@ impl<'m> ContactSolver<'m> {
     pub fn new(model: &Model, joints: &'m [ContactJoint]) -> ContactSolver<'m> {
         let size = joints.iter().map(|j| j.tag.size).fold(0.0, f64::max);
         let mass = &model.mass;
-        let mut inv_mass: Vec<f64> = (0..model.n_nodes())
-            .map(|n| if model.fixed[n] == 0 && mass.inertial[n] > 0.0 { 1.0 / mass.inertial[n] } else { 0.0 })
-            .collect();
+        // a node with a free component moves under contact forces (on its free components)
+        let movable = |n: usize| model.fixed[n] != ALL_FIXED;
+        let mut inv_mass: Vec<f64> = (0..model.n_nodes()).map(|n| if movable(n) && mass.inertial[n] > 0.0 { 1.0 / mass.inertial[n] } else { 0.0 }).collect();
         // a block node: its largest inverse mass (for the penalty bound and the colouring's
-        // test of a moving node); the pairs' laws read it as their mobility in every direction
-        let block_nodes: Vec<u32> = mass.blocks.iter().filter(|b| model.fixed[b.node as usize] == 0).map(|b| b.node).collect();
+        // test of a moving node); the pairs read it as their mobility and move the node by the
+        // full block (`mob_matrix`;
+        // the block's inverse is already restricted to the free components)
+        let block_nodes: Vec<u32> = mass.blocks.iter().filter(|b| movable(b.node as usize)).map(|b| b.node).collect();
         for b in &mass.blocks {
             let n = b.node as usize;
-            inv_mass[n] = if model.fixed[n] == 0 { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
+            inv_mass[n] = if movable(n) { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
         }
-        ContactSolver { block_nodes, joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new(), aniso: Vec::new() }
+        let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
+        ContactSolver { block_nodes, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+    }
+
+    /// Whether `node` is partly fixed (and moves on its free components only).
+    #[inline]
+    fn is_partial(&self, node: u32) -> bool {
+        !self.partial.is_empty() && self.partial.binary_search(&node).is_ok()
     }
 
     /// Largest ω² added by penalty springs (Gershgorin bound on M^{-1/2} K_pen M^{-1/2},
@@ -308,6 +330,23 @@ impl<'m> ContactSolver<'m> {
             self.cand.dedup();
         }
     }
+}
+
+/// Updates in a row of a pair with a partly fixed node within one sweep (stopping early once an
+/// update moves no node by more than the marking tolerance): 8. Its scalar mobility is the
+/// largest of its directions' (module doc), so when the normal or the slip direction is at an
+/// angle to the free components one update leaves part of the pair's own residual; repeating
+/// it costs nothing elsewhere (other pairs update once). Measured on the slide case with its
+/// slave face fixed in x (docs/contact.md, "Partly fixed nodes").
+const PARTIAL_PAIR_UPDATES: usize = 8;
+
+/// `Model::fixed` of a node with all three components fixed.
+const ALL_FIXED: u8 = 7;
+
+/// A node's free components as a mask (1 free, 0 fixed).
+#[inline]
+fn free_mask(model: &Model, node: usize) -> Vector3<f64> {
+    Vector3::from_fn(|c, _| if model.is_free(node, c) { 1.0 } else { 0.0 })
 }
 
 #[inline]
@@ -466,7 +505,7 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
 /// loop rather than a test per pair, so that the full pass carries nothing of the list.
 #[inline(never)] // its own code, whatever the code around it (a sweep is long; one call per sweep)
 #[allow(clippy::too_many_arguments)]
-fn sweep_pass<const LISTED: bool>(active: &mut [Active], aniso: &[[Matrix3<f64>; 5]], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64) -> usize {
+fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]]) -> usize {
     let mut moving = 0;
     for &k in order.iter() {
         let k = k as usize;
@@ -478,43 +517,77 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], aniso: &[[Matrix3<f64>;
             *clock += 1;
             evaluated_at[k] = *clock;
         }
-        let [n, t1, t2] = a.frame;
-        // current relative quantities with all forces applied so far
-        let rel = a.relative_displacement(local);
-        let g_cur = a.gap0 + n.dot(&rel);
-        let dd = a.rel_u - rel;
-        // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
-        let g_trial = g_cur - a.dt2w * a.r_n;
-        let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
-        let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
-        let d_rn = resp.r_n - a.r_n;
-        let d_rt = resp.r_t - a.r_t;
-        // move the nodes by the force change (a fixed node or an unused entry has
-        // mobility 0 and does not move); the pairs on a node moved by more than the
-        // marking tolerance must be evaluated again (the clock only grows, so the max
-        // marks without a branch)
-        let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
-        // |du|² = |dr|² mob²: one norm per pair instead of one per node
-        let dr2 = dr.norm_squared();
-        if LISTED {
-            // (mob is the mobility along the pair's normal; at a block node no direction moves
-            // more than 1/m, the same bound within the block's added-mass ratio)
-            for b in 0..5 {
-                let l = &mut local[a.local[b] as usize];
-                l.moved_at = l.moved_at.max(*clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
+        if a.partial {
+            // a pair with a partly fixed node repeats its update (its scalar mobility is an
+            // upper bound of its directions', so one update may leave part of its own
+            // residual: `PARTIAL_PAIR_UPDATES`), until an update moves no node
+            let moved = update_pair::<LISTED, true>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix);
+            moving += moved as usize;
+            if moved {
+                for _ in 1..PARTIAL_PAIR_UPDATES {
+                    if !update_pair::<LISTED, true>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) {
+                        break;
+                    }
+                }
             }
         } else {
-            moving += (dr2 * a.mob2_max > mark_tol2) as usize;
+            moving += update_pair::<LISTED, false>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) as usize;
         }
-        a.move_nodes_into(local, aniso, &dr);
-        let e = &mut active[k];
-        e.gap = g_trial + e.dt2w * resp.r_n;
-        e.r_n = resp.r_n;
-        e.r_t = resp.r_t;
-        e.hist = resp.hist;
-        e.state = resp.state;
     }
-    moving
+    if LISTED { 0 } else { moving }
+}
+
+/// One update of active pair `a` (index `k`) in a sweep: its force from the current positions
+/// of its local nodes with its own force removed, the nodes moved by the change, and with
+/// `LISTED` the nodes it moves by more than the marking tolerance stamped at `clock`. `PARTIAL`:
+/// the pair has a partly fixed node and moves its nodes by `mob_matrix[k]`. Returns whether the
+/// update moved a node by more than the marking tolerance.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn update_pair<const LISTED: bool, const PARTIAL: bool>(a: &mut Active, k: usize, local: &mut [LocalNode], clock: u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]]) -> bool {
+    let [n, t1, t2] = a.frame;
+    // current relative quantities with all forces applied so far
+    let rel = a.relative_displacement(local);
+    let g_cur = a.gap0 + n.dot(&rel);
+    let dd = a.rel_u - rel;
+    // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
+    let g_trial = g_cur - a.dt2w * a.r_n;
+    let dt_trial = Vector2::new(dd.dot(&t1), dd.dot(&t2)) - a.dt2w * a.r_t;
+    let resp = pair_force_with_inverse(&laws[a.joint as usize], &a.hist0, g_trial, dt_trial, a.dt2w, a.inv_dt2w, a.area);
+    let d_rn = resp.r_n - a.r_n;
+    let d_rt = resp.r_t - a.r_t;
+    // move the nodes by the force change (a fixed node or an unused entry has
+    // mobility 0 and does not move); the pairs on a node moved by more than the
+    // marking tolerance must be evaluated again (the clock only grows, so the max
+    // marks without a branch)
+    let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
+    // |du|² = |dr|² mob²: one norm per pair instead of one per node
+    let dr2 = dr.norm_squared();
+    if LISTED {
+        for b in 0..5 {
+            let l = &mut local[a.local[b] as usize];
+            l.moved_at = l.moved_at.max(clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
+            if PARTIAL {
+                l.x += mob_matrix[k][b] * dr;
+            } else {
+                l.x += dr * a.mob[b];
+            }
+        }
+    } else if PARTIAL {
+        for b in 0..5 {
+            local[a.local[b] as usize].x += mob_matrix[k][b] * dr;
+        }
+    } else {
+        for b in 0..5 {
+            local[a.local[b] as usize].x += dr * a.mob[b];
+        }
+    }
+    a.gap = g_trial + a.dt2w * resp.r_n;
+    a.r_n = resp.r_n;
+    a.r_t = resp.r_t;
+    a.hist = resp.hist;
+    a.state = resp.state;
+    dr2 * a.mob2_max > mark_tol2
 }
 
 /// Whether active pair `a`, last evaluated at tick `since`, has a node moved after it.
@@ -530,7 +603,7 @@ impl ContactSolver<'_> {
     #[inline(never)] // out of line, so that profiles show the four parts of a step
     fn search_into(&mut self, model: &Model, history: &mut ContactState, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> f64 {
         self.active.clear();
-        self.aniso.clear();
+        self.mob_matrix.clear();
         self.penalty.clear();
         let mut penalty_work = 0.0;
         // ---------------------------------------------------------------- search
@@ -677,6 +750,25 @@ impl ContactSolver<'_> {
                     imm[a] = self.inv_mass[masters[a] as usize];
                     w += weights[a] * weights[a] * imm[a];
                 }
+                // a partly fixed node in the pair: the mobility per component, W = Σ c² P / m
+                // (diagonal); the update's scalar is its largest entry (module doc)
+                let partly_fixed = !self.partial.is_empty() && (self.is_partial(s as u32) || masters[..nm as usize].iter().any(|&m| self.is_partial(m)));
+                let is_block = |nd: u32| !self.block_nodes.is_empty() && self.block_nodes.binary_search(&nd).is_ok();
+                let on_block = is_block(s as u32) || masters[..nm as usize].iter().any(|&m| is_block(m));
+                let mut masks = [Vector3::repeat(1.0); 5];
+                if partly_fixed {
+                    masks[0] = free_mask(model, s);
+                    let mut wv = masks[0] * ims;
+                    for a in 0..nm as usize {
+                        masks[a + 1] = free_mask(model, masters[a] as usize);
+                        wv += masks[a + 1] * (weights[a] * weights[a] * imm[a]);
+                    }
+                    if wv.dot(&n.component_mul(&n)) == 0.0 {
+                        // no node of the pair can move along its normal: no contact force
+                        continue;
+                    }
+                    w = wv.max();
+                }
                 if w == 0.0 {
                     continue;
                 }
@@ -736,30 +828,22 @@ impl ContactSolver<'_> {
                         mob[b + 1] = -dt2 * weights[b] * imi;
                     }
                 }
-                // a pair on a node with an inertia block moves its nodes by dt² M⁻¹ × the
-                // force (the full block, on the free components), while its law reads the
-                // node's largest inverse mass as its mobility: each update under-corrects the
-                // directions the block makes heavier, never over-corrects, and the sweeps
-                // converge to the forces of the true inertia (docs/contact.md, "Mobility of an
-                // anisotropic mass")
-                let mut aniso_index = NO_ANISO;
-                if !self.block_nodes.is_empty() && nodes5[..=nm as usize].iter().any(|nd| self.block_nodes.binary_search(nd).is_ok()) {
-                    let mut m = [Matrix3::zeros(); 5];
-                    for b in 0..=nm as usize {
-                        let nd = nodes5[b] as usize;
-                        let scale = if b == 0 { dt2 } else { -dt2 * weights[b - 1] };
-                        m[b] = match model.mass.block_of(nd) {
-                            Some(blk) if self.inv_mass[nd] > 0.0 => blk.inverse * scale,
-                            _ => Matrix3::identity() * (scale * self.inv_mass[nd]),
-                        };
-                    }
-                    aniso_index = self.aniso.len() as u32;
-                    self.aniso.push(m);
+                if !self.partial.is_empty() || !self.block_nodes.is_empty() {
+                    // one entry per active pair (indexed like `active`), read when `partial`:
+                    // the displacement a unit pair force gives each node, mob × its free
+                    // components, or at a node with an inertia block ±dt² N M⁻¹ (the block's
+                    // inverse, restricted to the free components; docs/contact.md, "Mobility
+                    // of an anisotropic mass")
+                    let nodes_b = nodes5;
+                    self.mob_matrix.push(std::array::from_fn(|b| match model.mass.block_of(nodes_b[b] as usize) {
+                        Some(blk) if b <= nm as usize && self.inv_mass[nodes_b[b] as usize] > 0.0 => blk.inverse * (mob[b] / self.inv_mass[nodes_b[b] as usize]),
+                        _ => Matrix3::from_diagonal(&masks[b]) * mob[b],
+                    }));
                 }
                 self.active.push(Active {
-                    aniso: aniso_index,
                     nodes: nodes5,
                     local: [0; 5],
+                    partial: partly_fixed || on_block,
                     mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
                     coef,
                     mob,
@@ -806,6 +890,18 @@ impl ContactSolver<'_> {
                 }
             }
         }
+        if !self.partial.is_empty() && !self.penalty.is_empty() {
+            // a partly fixed node takes a penalty force on its free components only: its fixed
+            // ones stay at the prediction's 0 (`Model::held`)
+            for &nd in &self.partial {
+                let nd = nd as usize;
+                for c in 0..3 {
+                    if !model.is_free(nd, c) {
+                        u_next[3 * nd + c] = 0.0;
+                    }
+                }
+            }
+        }
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             let s = s as usize;
             let mut du = (disp(u_next, s) - disp(u_prev, s)) * 0.5;
@@ -829,8 +925,8 @@ impl ContactSolver<'_> {
         self.step_clock += 1;
         self.local.clear();
         self.local_global.clear();
-        let ContactSolver { active, aniso, node, local, local_global, step_clock, .. } = self;
-        for a in active.iter_mut() {
+        let ContactSolver { active, node, local, local_global, step_clock, mob_matrix, .. } = self;
+        for (k, a) in active.iter_mut().enumerate() {
             // the pair's nodes among the local nodes, copied from the prediction when first met
             for b in 0..5 {
                 let nd = a.nodes[b] as usize;
@@ -849,7 +945,7 @@ impl ContactSolver<'_> {
             if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
                 let [n, t1, t2] = a.frame;
                 let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                a.move_nodes_into(local, aniso, &r);
+                a.move_nodes_into(local, &r, mob_matrix, k);
             }
         }
         if self.gs_colored {
@@ -874,7 +970,7 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, aniso, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, .. } = self;
+        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_matrix, .. } = self;
         let mut sweeps = 0;
         let mut converged = active.is_empty();
         for (x0, l) in sweep_start.iter_mut().zip(local.iter()) {
@@ -898,9 +994,9 @@ impl ContactSolver<'_> {
                 local.iter_mut().for_each(|l| l.moved_at = clock);
             }
             moving = if listed {
-                sweep_pass::<true>(active, aniso, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
+                sweep_pass::<true>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
             } else {
-                sweep_pass::<false>(active, aniso, order, local, evaluated_at, &mut clock, &laws, mark_tol2)
+                sweep_pass::<false>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
             };
             let max_du = sweep_change_into(local, sweep_start).sqrt();
             residual = max_du;

@@ -4,7 +4,8 @@
 
 use super::law::{JointLaw, OPEN_TOLERANCE_RELATIVE};
 use crate::error::{Error, ModelError};
-use crate::interface::{tag_joint, Joint, JointSpec};
+use crate::interface::{tag_joint_in, Joint, JointSpec};
+use crate::mesh::topology::Blocks;
 use crate::mesh::Mesh;
 use crate::scene::{ContactMethod, JointSceneSpec, OnExitSpec, Scene};
 use nalgebra::Vector3;
@@ -49,8 +50,8 @@ pub struct ContactJoint {
 }
 
 impl ContactJoint {
-    /// Tag a scene joint on the mesh and resolve its law and options.
-    pub fn build(mesh: &Mesh, spec: &JointSceneSpec, model_size: f64) -> Result<ContactJoint, Error> {
+    /// Tag a scene joint on the mesh (whose blocks are `blocks`) and resolve its law and options.
+    pub fn build(mesh: &Mesh, blocks: &Blocks, spec: &JointSceneSpec, model_size: f64) -> Result<ContactJoint, Error> {
         let bad = |m: String| -> Error { ModelError::Invalid(format!("joint \"{}\": {m}", spec.name)).into() };
         let mu = spec.friction().mu();
         let mut law = JointLaw {
@@ -88,7 +89,7 @@ impl ContactJoint {
         }
         let tol = spec.tolerance.unwrap_or(1e-6 * model_size);
         let js = JointSpec { name: spec.name.clone(), master: spec.master.clone(), slave: spec.slave.clone(), auto: spec.auto };
-        let tag = tag_joint(mesh, &js, tol)?;
+        let tag = tag_joint_in(mesh, blocks, &js, tol)?;
         // a pair "opens" (and loses its bond) only beyond the round-off of its gap
         let coord = tag.slave.nodes.iter().chain(&tag.master.nodes).flat_map(|&n| mesh.nodes[n]).fold(0.0f64, |m, x| m.max(x.abs()));
         law.open_tolerance = OPEN_TOLERANCE_RELATIVE * (coord + tag.size);
@@ -110,5 +111,9 @@ impl ContactJoint {
 /// tolerance is 1e-6 × the mesh's bounding-box diagonal.
 pub fn build_joints(mesh: &Mesh, scene: &Scene) -> Result<Vec<ContactJoint>, Error> {
     let size = mesh.diagonal();
-    scene.joints.iter().map(|js| ContactJoint::build(mesh, js, size)).collect()
+    if scene.joints.is_empty() {
+        return Ok(Vec::new());
+    }
+    let blocks = Blocks::of(mesh);
+    scene.joints.iter().map(|js| ContactJoint::build(mesh, &blocks, js, size)).collect()
 }

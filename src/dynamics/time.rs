@@ -49,8 +49,13 @@ impl TimeStep {
         let steps = time.duration / dt;
         if !(steps <= time.max_steps as f64) {
             return Err(ModelError::Invalid(format!(
-                "time.duration {} s at dt {dt:.4e} s is {steps:.3e} steps, above time.max_steps = {} (stable step {dt_stable:.4e} s, set by element {} in \"{}\"). Shorten the duration, coarsen the critical element, or raise time.max_steps to allow it.",
-                time.duration, time.max_steps, model.critical.tag, model.critical.group
+                "time.duration {} s at dt {dt:.4e} s is {steps:.3e} steps, above time.max_steps = {} (stable step {dt_stable:.4e} s, set by element {} in \"{}\", scaled Jacobian {:.3}{}). Shorten the duration, coarsen the critical element, or raise time.max_steps to allow it.",
+                time.duration,
+                time.max_steps,
+                model.critical.tag,
+                model.critical.group,
+                model.critical.scaled_jacobian,
+                if model.critical.is_sliver() { ": a sliver, a better shaped mesh raises the step (docs/elements.md, \"Mesh quality\")" } else { "" }
             )));
         }
         Ok(TimeStep { dt, dt_stable, dt_elements, penalty_omega2 })

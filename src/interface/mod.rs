@@ -39,6 +39,7 @@ pub use synthetic::flat_joint_mesh;
 pub use write::{JOINT_JSON_VERSION, write_joint_json, write_joint_vtu};
 
 use crate::error::InterfaceError;
+use crate::mesh::topology::Blocks;
 use crate::mesh::Mesh;
 
 /// A slave node is NTN-conforming when its distance to O is below this fraction of the joint
@@ -167,7 +168,17 @@ pub(crate) fn invalid(joint: &str, message: impl Into<String>) -> InterfaceError
 /// `tolerance` [m]: the largest allowed distance from a slave node to the master surface; a joint
 /// whose sides are farther apart is an error that quotes the distance and the node. It must be
 /// finite and ≥ 0 (a value like 1e-6 × the model size accepts Gmsh round-off on touching faces).
+///
+/// The mesh's blocks (element connectivity, [`Blocks`]) are computed here; to tag several joints
+/// of one mesh compute them once and call [`tag_joint_in`].
 pub fn tag_joint(mesh: &Mesh, spec: &JointSpec, tolerance: f64) -> Result<Joint, InterfaceError> {
+    tag_joint_in(mesh, &Blocks::of(mesh), spec, tolerance)
+}
+
+/// [`tag_joint`] with the mesh's blocks given. Besides its checks, a joint whose master and slave
+/// faces bound one block (volume elements connected through shared nodes) is an error naming
+/// the joint and both groups ([`check_two_blocks`]).
+pub fn tag_joint_in(mesh: &Mesh, blocks: &Blocks, spec: &JointSpec, tolerance: f64) -> Result<Joint, InterfaceError> {
     let name = spec.name.as_str();
     if !(tolerance.is_finite() && tolerance >= 0.0) {
         return Err(invalid(name, format!("tolerance {tolerance} m must be finite and >= 0")));
@@ -183,6 +194,7 @@ pub fn tag_joint(mesh: &Mesh, spec: &JointSpec, tolerance: f64) -> Result<Joint,
     }
     let named_master = Surface::from_group(mesh, name, &spec.master)?;
     let named_slave = Surface::from_group(mesh, name, &spec.slave)?;
+    check_two_blocks(mesh, blocks, name, &named_master, &named_slave)?;
     let swapped = spec.auto && named_master.mean_face_area() < named_slave.mean_face_area();
     let (master, slave) = if swapped { (named_slave, named_master) } else { (named_master, named_slave) };
 
@@ -249,7 +261,38 @@ pub fn tag_joint(mesh: &Mesh, spec: &JointSpec, tolerance: f64) -> Result<Joint,
 
 /// Tag every joint, in order; the first failure is returned.
 pub fn tag_joints(mesh: &Mesh, specs: &[JointSpec], tolerance: f64) -> Result<Vec<Joint>, InterfaceError> {
-    specs.iter().map(|s| tag_joint(mesh, s, tolerance)).collect()
+    let blocks = Blocks::of(mesh);
+    specs.iter().map(|s| tag_joint_in(mesh, &blocks, s, tolerance)).collect()
+}
+
+/// A joint separates two blocks meshed apart: its master and slave faces must bound volume
+/// elements of different blocks (no chain of elements sharing nodes joins them). Faces of one
+/// block — two names for the same faces, or two faces of one body — would put the contact force
+/// inside a body (issue 19: such a joint passed `tag` and `run` then blamed "penalty contact").
+/// The dam's monoliths and foundation, meshed apart and tied through non-conforming
+/// interfaces, share no node and stay separate blocks (`dam::dam_joints_are_faces_of_two_blocks`).
+/// A joint that ends inside a body (its two sides joined beyond its tip) is therefore refused too.
+pub fn check_two_blocks(mesh: &Mesh, blocks: &Blocks, joint: &str, master: &Surface, slave: &Surface) -> Result<(), InterfaceError> {
+    let mut master_blocks: Vec<(u32, usize)> = master.faces.iter().map(|f| (blocks.block_of(f.volume_cell), f.cell)).collect();
+    master_blocks.sort_unstable();
+    master_blocks.dedup_by_key(|b| b.0);
+    for f in &slave.faces {
+        let b = blocks.block_of(f.volume_cell);
+        if let Ok(k) = master_blocks.binary_search_by_key(&b, |m| m.0) {
+            let m = master_blocks[k].1;
+            return Err(invalid(
+                joint,
+                format!(
+                    "master group \"{}\" and slave group \"{}\" are faces of the same block (master face element {} and slave face element {} \
+                     bound volume elements connected through shared nodes), so the contact force would act inside one body. \
+                     A joint separates two blocks meshed apart: give it a face group of each block (in gmsh, two volumes whose common \
+                     surface is not merged: no Coherence or BooleanFragments across the joint), or remove the joint.",
+                    master.group, slave.group, mesh.cells[m].tag, mesh.cells[f.cell].tag
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Index and value of the largest entry (first on ties); (0, 0.0) when empty.

@@ -13,6 +13,7 @@
 pub mod cell;
 pub mod msh;
 pub mod pattern;
+pub mod quality;
 pub mod structured;
 pub mod topology;
 

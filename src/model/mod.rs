@@ -80,6 +80,22 @@ pub struct CriticalElement {
     pub group: String,
     /// Largest element eigenvalue ω² [1/s²].
     pub omega2: f64,
+    /// Its shape quality: the scaled Jacobian ([`crate::mesh::quality`]; 1 for a regular tet
+    /// or a cube, about 0 for a sliver, below [`crate::mesh::quality::SLIVER_SCALED_JACOBIAN`]
+    /// the run warns).
+    pub scaled_jacobian: f64,
+    /// Its element step 2/ω over the mean element step of its block (the elements of its
+    /// material group): how much smaller than the block's typical element's its step is (1 when
+    /// every element of the block is alike).
+    pub step_ratio: f64,
+}
+
+impl CriticalElement {
+    /// Whether the element setting the step is a sliver (scaled Jacobian below
+    /// [`crate::mesh::quality::SLIVER_SCALED_JACOBIAN`]).
+    pub fn is_sliver(&self) -> bool {
+        self.omega2 > 0.0 && self.scaled_jacobian < crate::mesh::quality::SLIVER_SCALED_JACOBIAN
+    }
 }
 
 /// Everything that does not change during a run.
@@ -504,7 +520,7 @@ impl Model {
             alpha,
             mass_damped,
             beta,
-            critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0 },
+            critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0, scaled_jacobian: 1.0, step_ratio: 1.0 },
             massless,
             massless_cells: element_massless_cell,
             condensed,
@@ -555,17 +571,26 @@ impl Model {
         // the mass of other elements: the foundation's bound on them is the foundation module's);
         // its layer elements along a joint have their mass and count as usual
         let pure_massless = |cell: u32| self.massless_cells[cell as usize];
-        let t = (0..self.tets.nodes.len())
+        // per tet its ω²_max (0 for a pure massless one: it sets no step)
+        let tet_omega: Vec<f64> = (0..self.tets.nodes.len())
             .into_par_iter()
-            .filter(|&e| !pure_massless(self.tets.cell[e]))
             .map(|e| {
+                if pure_massless(self.tets.cell[e]) {
+                    return 0.0;
+                }
                 let m = &self.materials[self.tets.mat[e] as usize];
                 let g = &self.tets.geom[e];
                 // a massless element (ρ = 0) sets no stable step: its nodes are condensed statically
-                let w = if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) } else { 0.0 };
-                (w, self.tets.cell[e] as usize, self.tets.mat[e] as usize)
+                if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) } else { 0.0 }
             })
-            .reduce(|| (0.0, 0, 0), |a, b| if b.0 > a.0 || (b.0 == a.0 && b.1 < a.1) { b } else { a });
+            .collect();
+        let mut t = (0.0, 0, 0);
+        for (e, &w) in tet_omega.iter().enumerate() {
+            let c = self.tets.cell[e] as usize;
+            if w > t.0 || (w == t.0 && c < t.1) {
+                t = (w, c, self.tets.mat[e] as usize);
+            }
+        }
         // shapes are shared: one eigenvalue per (shape), with the material of its first element
         // (a shape belongs to one material: the congruence key includes it)
         let mut shape_mat = vec![u16::MAX; self.hexes.shapes.len()];
@@ -595,7 +620,28 @@ impl Model {
                 best = (w, c, self.hexes.mat[e] as usize);
             }
         }
-        CriticalElement { tag: self.mesh.cells[best.1].tag, group: self.materials[best.2].group.clone(), omega2: best.0 }
+        // the mean element step 2/ω of the critical element's block (its material's elements
+        // that set a step)
+        let (mut sum, mut count) = (0.0, 0usize);
+        let mut add = |w: f64| {
+            if w > 0.0 {
+                sum += 2.0 / w.sqrt();
+                count += 1;
+            }
+        };
+        for (e, &w) in tet_omega.iter().enumerate() {
+            if self.tets.mat[e] as usize == best.2 {
+                add(w);
+            }
+        }
+        for e in 0..self.hexes.nodes.len() {
+            if self.hexes.mat[e] as usize == best.2 && !pure_massless(self.hexes.cell[e]) {
+                add(shape_omega[self.hexes.shape[e] as usize]);
+            }
+        }
+        let step_ratio = if best.0 > 0.0 && count > 0 { (2.0 / best.0.sqrt()) / (sum / count as f64) } else { 1.0 };
+        let scaled_jacobian = crate::mesh::quality::cell_scaled_jacobian(&self.mesh, best.1).unwrap_or(1.0);
+        CriticalElement { tag: self.mesh.cells[best.1].tag, group: self.materials[best.2].group.clone(), omega2: best.0, scaled_jacobian, step_ratio }
     }
 
     /// Stable time step [s] of the central-difference scheme with Rayleigh damping:

@@ -259,6 +259,8 @@ impl Recorder {
             dt_stable: sim.time.dt_stable,
             critical_element: model.critical.tag,
             critical_group: model.critical.group.clone(),
+            critical_scaled_jacobian: Some(model.critical.scaled_jacobian),
+            critical_step_ratio: Some(model.critical.step_ratio),
             steps: sim.n_steps(),
             duration: scene.time.duration,
             threads: rayon::current_num_threads(),
@@ -284,11 +286,23 @@ impl Recorder {
         }
     }
 
-    /// What the run got through but should not be trusted without a look: lost contact
+    /// What the run got through but should not be trusted without a look: a sliver setting the
+    /// stable step ([`crate::mesh::quality::SLIVER_SCALED_JACOBIAN`]), lost contact
     /// ([`LOST_WARN_FRACTION`]), an unconverged Gauss–Seidel ([`GS_WARN_FACTOR`]), NTN on a
     /// non-conforming joint ([`NTN_WARN_FRACTION`]).
     fn warnings(&self, sim: &Simulation<'_>) -> Vec<String> {
         let mut w = Vec::new();
+        let c = &sim.problem.model.critical;
+        if c.is_sliver() {
+            w.push(format!(
+                "the stable step is set by a sliver: element {} in \"{}\" has a scaled Jacobian of {:.3} (below {}) and a step {:.2} × its block's mean element step; a better shaped mesh would allow a larger step (gmsh: Mesh.Optimize 1, Mesh.OptimizeNetgen 1; docs/elements.md, \"Mesh quality\")",
+                c.tag,
+                c.group,
+                c.scaled_jacobian,
+                crate::mesh::quality::SLIVER_SCALED_JACOBIAN,
+                c.step_ratio
+            ));
+        }
         let Some(jw) = self.joints.as_ref() else { return w };
         let steps = self.stop.unwrap_or(sim.n_steps()).max(1) as f64;
         for (pk, j) in jw.peaks.iter().zip(&sim.problem.joints) {

@@ -30,6 +30,13 @@ pub struct RunSummary {
     pub dt_stable: f64,
     pub critical_element: u64,
     pub critical_group: String,
+    /// The critical element's scaled Jacobian (1 regular tet or cube, about 0 a sliver:
+    /// `mesh::quality`, docs/elements.md "Mesh quality"); `None` in summaries written before it.
+    #[serde(default)]
+    pub critical_scaled_jacobian: Option<f64>,
+    /// The critical element's step 2/ω over the mean element step of its block; `None` before.
+    #[serde(default)]
+    pub critical_step_ratio: Option<f64>,
     pub steps: usize,
     pub duration: f64,
     pub threads: usize,
@@ -140,12 +147,16 @@ impl RunSummary {
         let _ = writeln!(s, "  mesh            {}", self.mesh.display());
         let _ = writeln!(
             s,
-            "  time step       dt = {:.4e} s ({:.0}% of the stable {:.4e} s; critical element {} in \"{}\")",
+            "  time step       dt = {:.4e} s ({:.0}% of the stable {:.4e} s; critical element {} in \"{}\"{})",
             self.dt,
             100.0 * self.dt / self.dt_stable,
             self.dt_stable,
             self.critical_element,
-            self.critical_group
+            self.critical_group,
+            match (self.critical_scaled_jacobian, self.critical_step_ratio) {
+                (Some(q), Some(r)) => format!(", scaled Jacobian {q:.3}, its step {r:.2} × its block's mean"),
+                _ => String::new(),
+            }
         );
         let _ = writeln!(s, "  steps           {} over {} s on {} thread{}", self.steps, self.duration, self.threads, if self.threads == 1 { "" } else { "s" });
         if let Some(eq) = &self.equilibrium {

@@ -243,6 +243,24 @@ fn tag_with_a_tolerance_too_small_names_the_far_node() {
     assert_mentions(&msg, &["joint \"J\"", "\"joint:J:upper\"", "\"bc:base\"", "tolerance 1.000e-3 m", "5.000000e-1 m from the master surface", "raise the tolerance"]);
 }
 
+/// Issue 19: a joint whose master and slave are faces of the same block (here the lower box's
+/// top face and its base, with a tolerance that lets every slave node reach the master) passed
+/// `tag`, and `run` then blamed "penalty contact" for an nts joint. Both now refuse it up
+/// front, naming the joint, the two groups and the fix.
+#[test]
+fn joint_with_master_and_slave_on_the_same_block_is_named() {
+    let mut s = boxes_scene("joint:J:lower", "bc:base");
+    s["joints"][0]["tolerance"] = json!(1.0);
+    let parts = ["joint \"J\"", "\"joint:J:lower\"", "\"bc:base\"", "same block", "a face group of each block"];
+    assert_mentions(&tag_error("tag_same_block", &s), &parts);
+    s["boundary"] = json!([{"group": "bc:base"}]);
+    s["time"] = json!({"duration": 0.001});
+    s["output"] = json!({"frames": false});
+    let msg = run_error("run_same_block", &s);
+    assert_mentions(&msg, &parts);
+    assert!(!msg.contains("penalty"), "{msg}");
+}
+
 #[test]
 fn duplicate_joint_file_names_are_refused() {
     let mut s = boxes_scene("joint:J:lower", "joint:J:upper");

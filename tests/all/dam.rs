@@ -176,6 +176,26 @@ fn dam_tag_scene_tags_28_non_conforming_joints_from_one_entry() {
     assert!(out.join("tagging/joints.json").exists());
 }
 
+/// The same-block check of the tagger (issue 19: a joint must separate two blocks) holds on
+/// the dam: its 29 monoliths and the rock are meshed apart (the dam–rock interface is tied
+/// through non-conforming faces, which share no node), so the element graph has 30 separate
+/// blocks, and each of the 28 joints and the base interface has its sides on two of them
+/// (`dam_tag_scene_tags_28_non_conforming_joints_from_one_entry` tags them all through `tag`).
+#[test]
+fn dam_joints_are_faces_of_two_blocks() {
+    use jointquake::interface::{check_two_blocks, Surface};
+    use jointquake::mesh::topology::Blocks;
+    let m = dam();
+    let blocks = Blocks::of(&m);
+    assert_eq!(blocks.count(), N_JOINTS + 2, "monoliths + rock");
+    let mut pairs: Vec<(String, String)> = (1..=N_JOINTS).map(|k| (format!("joint:{k:02}:left"), format!("joint:{k:02}:right"))).collect();
+    pairs.push(("interface:rock:base".into(), "interface:dam:base".into()));
+    for (a, b) in pairs {
+        let (sa, sb) = (Surface::from_group(&m, "J", &a).unwrap(), Surface::from_group(&m, "J", &b).unwrap());
+        check_two_blocks(&m, &blocks, "J", &sa, &sb).unwrap_or_else(|e| panic!("{a} / {b}: {e}"));
+    }
+}
+
 /// Slave tributary areas sum to the slave surface area (round-off: 1e-9 relative), and the two
 /// sides of a joint have the same area within 1 % (measured ≤ 0.51 %: the sides are the same
 /// plane region, bounded by the same curved profiles cut into different chords; see above).

@@ -797,3 +797,62 @@ fn gauss_seidel_cap_reports_the_residual_and_warns() {
     assert!(s.warnings.iter().any(|w| w.contains("Gauss–Seidel stopped") && w.contains("residual up to")), "{:?}", s.warnings);
     assert!(s.to_text().contains("residual up to"));
 }
+
+/// A scene on a tet fixture (the boxes, no joint: the step is the elements' alone).
+fn boxes_tet_scene(msh: &str) -> Value {
+    json!({
+        "geometry": {"msh": fixture(msh)},
+        "materials": [
+            {"group": "block:lower", "E": 30e9, "nu": 0.2, "rho": 2400},
+            {"group": "block:upper", "E": 30e9, "nu": 0.2, "rho": 2400}
+        ],
+        "boundary": [{"group": "bc:base"}],
+        "time": {"duration": 1e-4},
+        "output": {"frames": false}
+    })
+}
+
+/// Issue 19 (sliver tets): the stable step is printed with the element that sets it, its
+/// scaled Jacobian (mesh::quality: 1 regular, about 0 flat) and its step over its block's mean;
+/// a sliver below 0.2 (`SLIVER_SCALED_JACOBIAN`) is a warning in summary.json and on the
+/// terminal. sliver_tet.msh is boxes_tet.msh with one top corner node moved down by 0.23 of its
+/// 0.25 m layer (scripts/fixtures.sh): the flattened tet under it has a scaled Jacobian of 0.04
+/// (computed independently with numpy on the fixture: 0.0397) and sets the step. The unaltered
+/// boxes_tet.msh (structured, 6 tets per cell) sets it with a well-shaped tet (≥ 0.408, its
+/// smallest) and no warning.
+#[test]
+fn sliver_setting_the_stable_step_is_named_with_its_quality() {
+    use jointquake::mesh::quality::{cell_scaled_jacobian, SLIVER_SCALED_JACOBIAN};
+    let run_on = |msh: &str| {
+        let dir = scratch(&format!("outputs/quality_{msh}"));
+        let p = write_scene(&dir, &boxes_tet_scene(msh));
+        run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).expect("runs")
+    };
+    let good = run_on("boxes_tet.msh");
+    let q = good.critical_scaled_jacobian.expect("written");
+    assert!(q >= 0.40 && q <= 1.0, "structured tets: {q}");
+    assert!(good.warnings.iter().all(|w| !w.contains("sliver")), "{:?}", good.warnings);
+    let bad = run_on("sliver_tet.msh");
+    let q = bad.critical_scaled_jacobian.expect("written");
+    assert!((q - 0.0397).abs() < 1e-3 && q < SLIVER_SCALED_JACOBIAN, "sliver: {q}");
+    // the element named is the flattened one, and the quality is that element's
+    let m = Mesh::from_msh(fixture("sliver_tet.msh")).unwrap();
+    let cell = m.cells.iter().position(|c| c.tag == bad.critical_element).expect("the critical element is a cell");
+    assert_eq!(cell_scaled_jacobian(&m, cell), Some(q));
+    assert!(bad.dt_stable < 0.5 * good.dt_stable, "the sliver lowers the step: {} vs {}", bad.dt_stable, good.dt_stable);
+    let r = bad.critical_step_ratio.expect("written");
+    assert!(r > 0.0 && r < 0.5, "step ratio {r}");
+    let w = bad.warnings.iter().find(|w| w.contains("sliver")).unwrap_or_else(|| panic!("no sliver warning: {:?}", bad.warnings));
+    for part in [format!("element {}", bad.critical_element), "\"block:upper\"".into(), format!("{q:.3}"), "below 0.2".into(), "Mesh quality".into()] {
+        assert!(w.contains(&part), "{part:?} not in {w}");
+    }
+    let text = bad.to_text();
+    assert!(text.contains(&format!("scaled Jacobian {q:.3}")) && text.contains("WARNING") && text.contains("sliver"), "{text}");
+    // a run refused for its step count says so up front too
+    let dir = scratch("outputs/quality_max_steps");
+    let mut sc = boxes_tet_scene("sliver_tet.msh");
+    sc["time"]["max_steps"] = json!(1);
+    let p = write_scene(&dir, &sc);
+    let e = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).err().expect("refused").to_string();
+    assert!(e.contains(&format!("element {}", bad.critical_element)) && e.contains(&format!("scaled Jacobian {q:.3}")) && e.contains("a sliver"), "{e}");
+}
