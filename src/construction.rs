@@ -17,8 +17,12 @@
 //!   (their Mohr–Coulomb law: pairs may open or slip), gravity kept: an active-set direct
 //!   solve from the grouted state (`static_contact`).
 //!
-//! Grouting: a joint is grouted pair by pair; a slave node that finds no master face (even
-//! within half a face) keeps offset 0 and is counted.
+//! Grouting: a joint is grouted pair by pair, with the gap its method measures: along the slave
+//! normal to the master face for node-to-segment (a slave node that finds no master face, even
+//! within half a face, keeps offset 0 and is counted), to the master node O for node-to-node
+//! (regression `dam_ntn_static_state_stays_at_rest`: grouted on the faces, the node-to-node
+//! joints started with the chords' gaps to O and the run stopped on its energy check at step
+//! 10).
 //!
 //! Each stage's residual and method are in the returned [`SequenceReport`] and the run's notes.
 
@@ -122,6 +126,14 @@ pub fn grout_pairs(problem: &Problem, contact: &mut ContactState, u: &[f64], whi
             }
             let xs = pos(s);
             let n = j.frames[i][0];
+            if j.method == crate::contact::joint::Method::Ntn {
+                // node-to-node: the gap is measured to the slave's master node O
+                let gap = n.dot(&(pos(j.tag.nearest_master_node(i)) - xs));
+                contact.joints[ji].pairs[i].gap_offset = gap;
+                largest = largest.max(gap.abs());
+                pairs += 1;
+                continue;
+            }
             let faces: Vec<(usize, Vec<Vector3<f64>>)> = j.tag.layer2.row(i).iter().map(|&f| (f as usize, m.faces[f as usize].nodes().iter().map(|&nd| pos(nd as usize)).collect())).collect();
             let project = |tol: f64| select_projection(&xs, &n, faces.iter().map(|(f, x)| (*f, x.as_slice())), tol).map_err(|e| ModelError::Invalid(format!("grouting joint \"{}\": {e}", j.tag.name)));
             let hit = match project(j.edge_tolerance)? {

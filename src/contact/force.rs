@@ -208,6 +208,9 @@ pub struct ContactSolver<'m> {
     mob_matrix: Vec<[Matrix3<f64>; 5]>,
     /// The free nodes with a 3×3 inertia block, ascending (empty for most models).
     block_nodes: Vec<u32>,
+    /// The slave nodes of the tied joints, ascending (empty without tied joints): a pair of
+    /// another joint whose nodes are all among them is not formed (`search_into`).
+    tied_nodes: Vec<u32>,
     cand: Vec<u32>,
     /// Per model node, its place among the local nodes (see [`NodeScratch`]).
     node: Vec<NodeScratch>,
@@ -239,8 +242,11 @@ impl<'m> ContactSolver<'m> {
             let n = b.node as usize;
             inv_mass[n] = if movable(n) { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
         }
+        let mut tied_nodes: Vec<u32> = joints.iter().filter(|j| j.law.tied).flat_map(|j| j.tag.slave_nodes().iter().map(|&n| n as u32)).collect();
+        tied_nodes.sort_unstable();
+        tied_nodes.dedup();
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
-        ContactSolver { block_nodes, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { block_nodes, tied_nodes, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Whether `node` is partly fixed (and moves on its free components only).
@@ -332,13 +338,18 @@ impl<'m> ContactSolver<'m> {
     }
 }
 
-/// Updates in a row of a pair with a partly fixed node within one sweep (stopping early once an
-/// update moves no node by more than the marking tolerance): 8. Its scalar mobility is the
-/// largest of its directions' (module doc), so when the normal or the slip direction is at an
-/// angle to the free components one update leaves part of the pair's own residual; repeating
-/// it costs nothing elsewhere (other pairs update once). Measured on the slide case with its
-/// slave face fixed in x (docs/contact.md, "Partly fixed nodes").
-const PARTIAL_PAIR_UPDATES: usize = 8;
+/// Updates in a row of a pair with a partly fixed node or an inertia-block node within one
+/// sweep (stopping early once an update moves no node by more than the marking tolerance): 32.
+/// Its scalar mobility is the largest of its directions' (module doc), so when the normal or
+/// the slip direction is at an angle to the free components, or the block makes a direction
+/// heavier, one update leaves part of the pair's own residual (a fraction m_a/(m + m_a), about
+/// 0.7, on the dam's wet joint nodes); repeating it costs nothing elsewhere (other pairs update
+/// once). 8 was enough on the slide case with its slave face fixed in x (docs/contact.md,
+/// "Partly fixed nodes"); on the coarse dam with a full reservoir released at rest, 8 left the
+/// wet pairs' Gauss–Seidel unconverged step after step and the dam went unstable after 1.5 s
+/// (crest velocity from 1e-3 to 13 m/s by 2 s), 32 keeps it at rest for 2 s with the energy
+/// balance at 4e-15 (regression `dam_stays_at_rest_for_two_seconds_with_a_full_reservoir`).
+const PARTIAL_PAIR_UPDATES: usize = 32;
 
 /// `Model::fixed` of a node with all three components fixed.
 const ALL_FIXED: u8 = 7;
@@ -743,6 +754,21 @@ impl ContactSolver<'_> {
                         }
                     }
                 };
+                // A pair whose slave and master nodes are all tied by a tied joint (node-to-node
+                // pairs on a joint's edge along the tied dam–rock base: the slave and its O both
+                // on the base) is redundant: the ties fix its relative motion, and a second,
+                // slightly different constraint on the same nodes fights them (the coarse dam's
+                // NTN joints grew a motion from rest, ×1.8 a step, until the energy check stopped
+                // them at step 70; regression `dam_ntn_static_state_stays_at_rest`). Such a
+                // pair is bonded, with no force of its own. Node-to-segment pairs always have a
+                // master node above the edge, so they are never dropped.
+                if !j.law.tied && !self.tied_nodes.is_empty() && std::iter::once(&(s as u32)).chain(&masters[..nm as usize]).all(|nd| self.tied_nodes.binary_search(nd).is_ok()) {
+                    let p = &mut rec.pairs[i];
+                    p.state = PairState::Bonded;
+                    p.r_n = 0.0;
+                    p.r_t = [0.0; 2];
+                    continue;
+                }
                 let ims = self.inv_mass[s];
                 let mut imm = [0.0; 4];
                 let mut w = ims;
