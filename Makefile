@@ -19,7 +19,7 @@ JOBS      ?= $(shell nproc 2>/dev/null || echo 2)
 # Shared libraries the gmsh wheel links (Debian package names).
 GMSH_DEBS := libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libgl1
 
-.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests dam-static dam
+.PHONY: demo test venv build mesh run bench clean fixtures fuzz study study-report wedge wedge3 wedge-report incline joint-tests dam-static dam dam-coarse
 
 # ---- set-up -------------------------------------------------------------------------
 $(VENV)/.ready:
@@ -156,6 +156,9 @@ test-slurm: build
 # 3x. Each run prints its start and end; a failed run is named in the report.
 dam:
 	$(MAKE) --no-print-directory study STUDY=pipelines/dam_study.json
+
+dam-coarse:
+	$(MAKE) --no-print-directory study STUDY=pipelines/dam_study_coarse.json
 
 bench: build
 	cargo bench --bench explicit
