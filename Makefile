@@ -158,7 +158,7 @@ dam:
 	$(MAKE) --no-print-directory study STUDY=pipelines/dam_study.json
 
 dam-coarse:
-	$(MAKE) --no-print-directory study STUDY=pipelines/dam_study_coarse.json
+	$(MAKE) --no-print-directory study STUDY=pipelines/dam_coarse_study.json
 
 bench: build
 	cargo bench --bench explicit

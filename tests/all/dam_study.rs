@@ -53,9 +53,12 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
     // References and tolerances:
     // - at small input the joints barely open or slide (tens of µm), so the two contact
     //   methods carry nearly the same forces: over the time both ran, the crown's largest
-    //   radial displacement within 1 % (measured: equal to 6 digits) and the largest opening and
-    //   slip over all joints within 10 % (measured 2.2 % and 3.4 %; the methods differ in where
-    //   the force acts on the master side, node O against the projection);
+    //   radial displacement within 5 % and the largest opening and slip over all joints within
+    //   10 % (measured over the whole 0.2 s: crown 2.3 %, opening equal to 4 digits, slip 3.4 %;
+    //   the methods differ in where the force acts on the master side, node O against the
+    //   projection, and O lies up to 10 m from its slave on this mesh. Before NTN's redundant
+    //   pairs on the tied base were dropped it stopped at 0.068 s, where the crowns agreed to
+    //   6 digits);
     // - opening ≥ 0 and slip ≥ 0 by definition (max(gap, 0), an accumulated path);
     // - the envelope is sampled at the last step too, so it bounds the last frame's principal
     //   stresses exactly (to round-off, 1e-9 relative).
@@ -183,7 +186,7 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
         a.0, b.0, a.1, b.1, a.2, b.2
     );
     assert!(
-        a.2 > 0.0 && (a.2 / b.2 - 1.0).abs() < 0.01,
+        a.2 > 0.0 && (a.2 / b.2 - 1.0).abs() < 0.05,
         "crown: {a:?} {b:?}"
     );
     assert!(
