@@ -196,13 +196,14 @@ pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
             // the explicit run's contact is exact and would push it out in one step, so they
             // are re-grouted where they are: the dynamic stage starts with them touching.
             let closed: Vec<Vec<bool>> = sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| r.state != crate::contact::law::PairState::Open).collect()).collect();
-            let (forces, gaps): (Vec<Vec<(f64, [f64; 2])>>, Vec<Vec<f64>>) =
-                (sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| (r.r_n, r.r_t)).collect()).collect(), sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| r.gap).collect()).collect());
             grout_pairs(p, &mut sim.state.contact, &sim.state.u, |ji, i| closed[ji][i])?;
+            // (grouting sets only the offsets: the pairs keep their forces and states; a
+            // closed pair's gap is 0 from here)
             for (ji, j) in sim.state.contact.joints.iter_mut().enumerate() {
                 for (i, r) in j.pairs.iter_mut().enumerate() {
-                    (r.r_n, r.r_t) = forces[ji][i];
-                    r.gap = if closed[ji][i] { 0.0 } else { gaps[ji][i] };
+                    if closed[ji][i] {
+                        r.gap = 0.0;
+                    }
                 }
             }
             stages.push(StageReport {

@@ -104,6 +104,15 @@ pub fn slave_normals_into(joint: &str, surface: &Surface, out: &mut [[f64; 3]]) 
     Ok(())
 }
 
+/// ∫ N_I dA of each node of one face with points `x` into `t` (quad4: `quad_tributary`; tri3:
+/// a third of the area each).
+fn face_tributaries_into(kind: CellKind, x: &[[f64; 3]; 4], t: &mut [f64; 4]) {
+    match kind {
+        CellKind::Quad4 => quad_tributary(x, t),
+        _ => *t = [face_area(kind, &x[..3]) / 3.0; 4],
+    }
+}
+
 /// Tributary area [m²] of every node of `surface` (local node order) into `out`.
 pub fn tributary_areas_into(surface: &Surface, out: &mut [f64]) {
     assert_eq!(out.len(), surface.nodes.len());
@@ -111,10 +120,7 @@ pub fn tributary_areas_into(surface: &Surface, out: &mut [f64]) {
     let mut t = [0.0; 4];
     for (f, face) in surface.faces.iter().enumerate() {
         let (x, n) = surface.face_points(f);
-        match face.kind {
-            CellKind::Quad4 => quad_tributary(&x, &mut t),
-            _ => t = [face_area(face.kind, &x[..3]) / 3.0; 4],
-        }
+        face_tributaries_into(face.kind, &x, &mut t);
         for (k, &l) in face.local_nodes().iter().enumerate().take(n) {
             out[l as usize] += t[k];
         }
@@ -131,10 +137,7 @@ pub fn tributary_vectors_into(surface: &Surface, out: &mut [[f64; 3]]) {
     let mut t = [0.0; 4];
     for (f, face) in surface.faces.iter().enumerate() {
         let (x, n) = surface.face_points(f);
-        match face.kind {
-            CellKind::Quad4 => quad_tributary(&x, &mut t),
-            _ => t = [face_area(face.kind, &x[..3]) / 3.0; 4],
-        }
+        face_tributaries_into(face.kind, &x, &mut t);
         let nf = face_unit_normal(face.kind, &x[..n]);
         for (k, &l) in face.local_nodes().iter().enumerate().take(n) {
             for c in 0..3 {

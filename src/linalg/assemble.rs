@@ -263,24 +263,7 @@ pub fn mass_matrix(diag: &[f64], blocks: &[(usize, [[f64; 3]; 3])], map: &[usize
             }
         }
     }
-    let mut col_ptr = vec![0];
-    let mut row = Vec::new();
-    let mut val = Vec::new();
-    for c in cols.iter_mut() {
-        c.sort_by_key(|e| e.0);
-        let mut last = NONE;
-        for &(r, v) in c.iter() {
-            if r == last {
-                *val.last_mut().unwrap() += v;
-            } else {
-                row.push(r);
-                val.push(v);
-                last = r;
-            }
-        }
-        col_ptr.push(row.len());
-    }
-    Csc { n_rows: n, n_cols: n, col_ptr, row, val }
+    from_columns(n, cols)
 }
 
 #[cfg(test)]
@@ -370,14 +353,14 @@ pub fn add_entries(a: &Csc, extra: &[(usize, usize, f64)]) -> Csc {
 }
 
 /// The matrix whose column j holds the entries `cols[j]` (row, value) in any order, duplicates
-/// summed.
+/// summed in the order given (a stable sort: the sums do not depend on the sort's internals).
 pub fn from_columns(n_rows: usize, mut cols: Vec<Vec<(usize, f64)>>) -> Csc {
     let nnz = cols.iter().map(|c| c.len()).sum();
     let mut col_ptr = Vec::with_capacity(cols.len() + 1);
     col_ptr.push(0);
     let (mut row, mut val) = (Vec::with_capacity(nnz), Vec::with_capacity(nnz));
     for c in cols.iter_mut() {
-        c.sort_unstable_by_key(|e| e.0);
+        c.sort_by_key(|e| e.0);
         let mut last = usize::MAX;
         for &(r, v) in c.iter() {
             if r == last {
