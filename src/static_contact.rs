@@ -87,6 +87,9 @@ pub struct StaticContactInfo {
     pub slip: usize,
     pub open: usize,
     pub left_out: usize,
+    /// Pairs not formed because their slave node is the slave of a tied joint
+    /// (`contact::joint::tied_slave_nodes`).
+    pub on_tied: usize,
     /// Pairs held closed because they kept opening and closing.
     pub held: usize,
     /// Largest penetration −g of a closed pair [m] and the largest |Δu| of the increment [m].
@@ -103,7 +106,7 @@ impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations, residual {:.1e}{}, pairs stick {} / slip {} / open {}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations, residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
             self.residual,
             if self.converged { "" } else { " (NOT converged)" },
@@ -111,6 +114,7 @@ impl StaticContactInfo {
             self.slip,
             self.open,
             if self.left_out > 0 { format!(" / left out {}", self.left_out) } else { String::new() },
+            if self.on_tied > 0 { format!(" / on tied nodes {}", self.on_tied) } else { String::new() },
             self.max_penetration,
             if self.max_displacement > 0.0 { self.max_penetration / self.max_displacement } else { 0.0 },
             if self.held > 0 { format!(", {} pairs held closed (largest tension {:.1e} of the largest normal force)", self.held, self.condition_violation) } else { String::new() }
@@ -173,11 +177,17 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let mut info = StaticContactInfo::default();
     // the pairs
     let mut pairs = Vec::new();
+    let tied_slaves = crate::contact::joint::tied_slave_nodes(&problem.joints);
     for (ji, j) in problem.joints.iter().enumerate() {
         if j.law.tied {
             continue;
         }
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
+            if tied_slaves.binary_search(&(s as u32)).is_ok() {
+                // the slave of a tied joint is the slave of no other joint (the rule: `tied_slave_nodes`)
+                info.on_tied += 1;
+                continue;
+            }
             let masters = match j.method {
                 Method::Ntn => vec![(j.tag.nearest_master_node(i), 1.0)],
                 _ => match master_point(model, j, i)? {

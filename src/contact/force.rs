@@ -242,9 +242,7 @@ impl<'m> ContactSolver<'m> {
             let n = b.node as usize;
             inv_mass[n] = if movable(n) { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
         }
-        let mut tied_nodes: Vec<u32> = joints.iter().filter(|j| j.law.tied).flat_map(|j| j.tag.slave_nodes().iter().map(|&n| n as u32)).collect();
-        tied_nodes.sort_unstable();
-        tied_nodes.dedup();
+        let tied_nodes = super::joint::tied_slave_nodes(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
         ContactSolver { block_nodes, tied_nodes, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
@@ -754,15 +752,10 @@ impl ContactSolver<'_> {
                         }
                     }
                 };
-                // A pair whose slave and master nodes are all tied by a tied joint (node-to-node
-                // pairs on a joint's edge along the tied dam–rock base: the slave and its O both
-                // on the base) is redundant: the ties fix its relative motion, and a second,
-                // slightly different constraint on the same nodes fights them (the coarse dam's
-                // NTN joints grew a motion from rest, ×1.8 a step, until the energy check stopped
-                // them at step 70; regression `dam_ntn_static_state_stays_at_rest`). Such a
-                // pair is bonded, with no force of its own. Node-to-segment pairs always have a
-                // master node above the edge, so they are never dropped.
-                if !j.law.tied && !self.tied_nodes.is_empty() && std::iter::once(&(s as u32)).chain(&masters[..nm as usize]).all(|nd| self.tied_nodes.binary_search(nd).is_ok()) {
+                // A pair whose slave node is the slave of a tied joint is not formed
+                // (`joint::tied_slave_nodes`: the tie fixes the node): reported bonded, with no
+                // force of its own.
+                if !j.law.tied && self.tied_nodes.binary_search(&(s as u32)).is_ok() {
                     let p = &mut rec.pairs[i];
                     p.state = PairState::Bonded;
                     p.r_n = 0.0;
