@@ -299,7 +299,7 @@ impl Recorder {
         // a sliver whose inertia was scaled sets the scaling's target step, not its own
         if c.is_sliver() && c.mass_factor == 1.0 {
             w.push(format!(
-                "the stable step is set by a sliver: element {} in \"{}\" has a scaled Jacobian of {:.3} (below {}) and a step {:.2} × its block's mean element step; a better shaped mesh would allow a larger step (gmsh: Mesh.Optimize 1, Mesh.OptimizeNetgen 1; docs/elements.md, \"Mesh quality\")",
+                "the stable step is set by a sliver: element {} in \"{}\" has a scaled Jacobian of {:.3} (below {}) and a step {:.2} × its block's mean element step; a better shaped mesh would allow a larger step (gmsh: Mesh.Algorithm3D = 10 (HXT), or Mesh.OptimizeNetgen = 1 with the default Delaunay; else time.mass_scaling; docs/elements.md, \"Mesh quality\")",
                 c.tag,
                 c.group,
                 c.scaled_jacobian,
