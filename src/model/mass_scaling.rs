@@ -46,10 +46,11 @@ impl MassScaling {
     /// One line for the run's notes.
     pub fn note(&self) -> String {
         format!(
-            "mass scaling to target dt {:.4e} s (element step {:.4e} s): {} elements scaled, added mass {:.4e} kg = {:.4} % of the total {:.4e} kg, largest factor {:.4} (element {}); gravity acts on the unscaled mass",
+            "mass scaling to target dt {:.4e} s (element step {:.4e} s): {} element{} scaled, added mass {:.4e} kg = {:.4} % of the total {:.4e} kg, largest factor {:.4} (element {}); gravity acts on the unscaled mass",
             self.target_dt,
             self.element_dt,
             self.scaled_elements,
+            if self.scaled_elements == 1 { "" } else { "s" },
             self.added_mass,
             100.0 * self.added_fraction(),
             self.total_mass,
@@ -62,11 +63,12 @@ impl MassScaling {
     pub fn warning(&self) -> Option<String> {
         (self.added_fraction() > ADDED_MASS_WARN_FRACTION).then(|| {
             format!(
-                "mass scaling added {:.4e} kg, {:.2} % of the total mass (above {:.0} %) on {} elements (largest factor {:.3}, element {}): the scaled model's dynamics differ from the material's by about that fraction; lower time.mass_scaling.target_dt or improve the mesh (docs/elements.md, \"Mass scaling\")",
+                "mass scaling added {:.4e} kg, {:.2} % of the total mass (above {:.0} %) on {} element{} (largest factor {:.3}, element {}): the scaled model's dynamics differ from the material's by about that fraction; lower time.mass_scaling.target_dt or improve the mesh (docs/elements.md, \"Mass scaling\")",
                 self.added_mass,
                 100.0 * self.added_fraction(),
                 100.0 * ADDED_MASS_WARN_FRACTION,
                 self.scaled_elements,
+                if self.scaled_elements == 1 { "" } else { "s" },
                 self.max_factor,
                 self.max_factor_element
             )

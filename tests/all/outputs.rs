@@ -906,7 +906,7 @@ fn mass_scaling_raises_the_sliver_step_to_the_target() {
         assert_eq!(ms.max_factor_element, el[0].2, "the sliver has the largest factor");
         assert!(rel(ms.max_factor, (t_elem / el[0].0).powi(2)) < 1e-9, "factor {}", ms.max_factor);
         eprintln!("mass scaling case {k}: target {target:.4e} s, {} elements scaled, added {:.4e} kg = {:.4} % of {total:.4e} kg, largest factor {:.2}", ms.scaled_elements, ms.added_mass, 100.0 * ms.added_fraction(), ms.max_factor);
-        assert!(s.notes.iter().any(|n| n.contains("mass scaling") && n.contains(&format!("{} elements scaled", below.len()))), "{:?}", s.notes);
+        assert!(s.notes.iter().any(|n| n.contains("mass scaling") && n.contains(&format!("{} element{} scaled", below.len(), if below.len() == 1 { "" } else { "s" }))), "{:?}", s.notes);
         assert!(s.warnings.iter().all(|w| !w.contains("sliver")), "{:?}", s.warnings);
         let warned = s.warnings.iter().any(|w| w.contains("mass scaling added") && w.contains("above 1 %"));
         assert_eq!(warned, added / total > 0.01, "warning iff the added mass exceeds 1 % ({:.3} %): {:?}", 100.0 * added / total, s.warnings);
