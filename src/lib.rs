@@ -24,7 +24,7 @@
 //! - scene fields, units and defaults, and the rules checked once (friction μ or φ, time-step
 //!   knobs, contact method enums): [`scene`] (and `docs/scenes.md`)
 //! - time integration, damping: [`dynamics`]; the one time-step rule: [`dynamics::time`]
-//! - masses (inertial vs gravitational, 3×3 inertia blocks, massless nodes): [`model::mass`]
+//! - masses (inertial vs gravitational, 3×3 inertia blocks, massless nodes): [`model::mass`]; selective mass scaling: [`model::mass_scaling`]
 //! - contact conventions (normal, gap sign, frame, forces): [`contact`]; the contact mobility of
 //!   an anisotropic mass: `docs/contact.md`
 //! - errors (what the user must fix): [`error`]

@@ -100,6 +100,7 @@ impl<'p> Simulation<'p> {
         let t0 = std::time::Instant::now();
         let foundation = crate::foundation::Condensation::build(model, faer::Par::Seq, method).map_err(|e| ModelError::Invalid(e.to_string()))?;
         let mut notes = problem.notes.clone();
+        notes.extend(model.mass_scaling.as_ref().map(|m| m.note()));
         // the condensed foundation stiffens the interface: its ω² bound adds to the elements'
         let found_w2 = foundation.as_ref().map(|f| f.omega2_bound()).unwrap_or(0.0);
         if let Some(f) = foundation.as_ref() {

@@ -12,10 +12,9 @@ use crate::error::ModelError;
 use crate::model::Model;
 use crate::scene::TimeSpec;
 
-/// Fraction of the stable step used when a scene gives neither `dt` nor `courant`. Default 0.9:
-/// a margin of 10 % for the element-eigenvalue estimate, which bounds ω_max from above for
-/// linear elements but not for contact stiffening or the round-off of very distorted elements.
-pub const DEFAULT_COURANT: f64 = 0.9;
+/// Fraction of the stable step used when a scene gives neither `dt` nor `courant` (defined with
+/// the scene, where the model's mass scaling reads it too).
+pub use crate::scene::DEFAULT_COURANT;
 
 /// The resolved time step of a run.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,7 +42,7 @@ impl TimeStep {
                 }
                 dt
             }
-            None if dt_stable.is_finite() => time.courant.unwrap_or(DEFAULT_COURANT) * dt_stable,
+            None if dt_stable.is_finite() => time.courant_or_default() * dt_stable,
             None => return Err(ModelError::Invalid("no element has mass, so none sets a stable step: give `time.dt` [s]".into())),
         };
         let steps = time.duration / dt;

@@ -23,6 +23,7 @@
 
 pub mod hex8;
 pub mod mass;
+pub mod mass_scaling;
 pub mod material;
 pub mod tet4;
 
@@ -31,6 +32,7 @@ use crate::mesh::{CellKind, Mesh};
 use crate::scene::Scene;
 use hex8::HexShape;
 use mass::NodalMass;
+use mass_scaling::MassScaling;
 use material::{Lame, Material};
 use nalgebra::Vector3;
 use rayon::prelude::*;
@@ -88,6 +90,9 @@ pub struct CriticalElement {
     /// material group): how much smaller than the block's typical element's its step is (1 when
     /// every element of the block is alike).
     pub step_ratio: f64,
+    /// The factor its density was scaled by for its inertia (`time.mass_scaling`; 1 unscaled).
+    /// Above 1, its step is the scaling's target, not its shape's.
+    pub mass_factor: f64,
 }
 
 impl CriticalElement {
@@ -131,6 +136,11 @@ pub struct Model {
     /// Per node: carries mass but no weight (its mass comes only from the layer of a massless
     /// block's elements along a joint face: docs/dam_physics.md).
     pub weightless: Vec<bool>,
+    /// Per mesh cell: the factor its density was scaled by for the inertial mass (scene
+    /// `time.mass_scaling`; [`mass_scaling`]); empty when no element is scaled (every factor 1).
+    pub mass_scale: Vec<f64>,
+    /// What the mass scaling did (`None` without `time.mass_scaling`).
+    pub mass_scaling: Option<MassScaling>,
 }
 
 /// Scatter target shared across threads. Safe use requires that no two concurrent writers touch
@@ -341,6 +351,18 @@ impl Model {
         let mut shapes: Vec<HexShape> = Vec::new();
         let mut shape_key: HashMap<(usize, [i64; 21]), u32> = HashMap::new();
         let mut mass = vec![0.0; n];
+        let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
+        // mass scaling (scene time.mass_scaling): the element ω² above which an element's density
+        // is scaled, its factor per mesh cell, and the scaled (inertial) nodal masses; `mass`
+        // stays the unscaled one (the weight)
+        let target_w2 = match &scene.time.mass_scaling {
+            Some(ms) => Some(mass_scaling::target_omega2(ms.target_dt / scene.time.courant_or_default(), alpha, beta).map_err(ModelError::Invalid)?),
+            None => None,
+        };
+        let mut mass_scale = if target_w2.is_some() { vec![1.0; mesh.cells.len()] } else { Vec::new() };
+        let mut inertial = if target_w2.is_some() { vec![0.0; n] } else { Vec::new() };
+        // ω² per hex shape, computed once when scaling (NaN: not yet)
+        let mut shape_w2: Vec<f64> = Vec::new();
         // mass from the elements of massive blocks alone (a node with only layer mass is weightless)
         let mut massive_mass = vec![0.0; n];
         let massless: Vec<bool> = scene.materials.iter().map(|m| m.massless).collect();
@@ -388,6 +410,14 @@ impl Model {
                 CellKind::Tet4 => {
                     // geometry recomputed in assembly order below (not stored twice)
                     let g = tet4::tet_geometry(&tet_x(cell.nodes())).ok_or_else(|| inverted(c, mi))?;
+                    if let Some(t) = target_w2 {
+                        // a pure massless element (rho 0 here) has no step and no inertia
+                        let s = if rho > 0.0 { mass_scaling::factor(tet4::max_eigenvalue(&g.grad, g.vol, rho, &materials[mi].lame), t) } else { 1.0 };
+                        mass_scale[c] = s;
+                        for a in 0..4 {
+                            inertial[cell.node(a)] += s * rho * g.vol / 4.0;
+                        }
+                    }
                     for a in 0..4 {
                         mass[cell.node(a)] += rho * g.vol / 4.0;
                         if !massless[mi] {
@@ -421,6 +451,23 @@ impl Model {
                         }
                     };
                     let s = &shapes[id as usize];
+                    if let Some(t) = target_w2 {
+                        let f = if rho > 0.0 {
+                            if shape_w2.len() <= id as usize {
+                                shape_w2.resize(id as usize + 1, f64::NAN);
+                            }
+                            if shape_w2[id as usize].is_nan() {
+                                shape_w2[id as usize] = hex8::max_eigenvalue(s, rho, &materials[mi].lame);
+                            }
+                            mass_scaling::factor(shape_w2[id as usize], t)
+                        } else {
+                            1.0
+                        };
+                        mass_scale[c] = f;
+                        for a in 0..8 {
+                            inertial[cell.node(a)] += f * rho * s.vol * s.mass_frac[a];
+                        }
+                    }
                     for a in 0..8 {
                         mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
                         if !massless[mi] {
@@ -486,7 +533,35 @@ impl Model {
         }
         let weightless: Vec<bool> = (0..n).map(|i| mass[i] > 0.0 && massive_mass[i] == 0.0).collect();
         drop(massive_mass);
-        let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
+        let mass_scaling = scene.time.mass_scaling.as_ref().map(|ms| {
+            let (mut count, mut max_factor, mut max_cell) = (0usize, 1.0, None);
+            for (c, &f) in mass_scale.iter().enumerate() {
+                if f > 1.0 {
+                    count += 1;
+                    if f > max_factor {
+                        (max_factor, max_cell) = (f, Some(c));
+                    }
+                }
+            }
+            // added = Σ (s − 1) ρ V: the scaled total minus the unscaled one
+            let total: f64 = mass.iter().sum();
+            let added = if count > 0 { inertial.iter().sum::<f64>() - total } else { 0.0 };
+            MassScaling {
+                target_dt: ms.target_dt,
+                element_dt: ms.target_dt / scene.time.courant_or_default(),
+                scaled_elements: count,
+                added_mass: added,
+                total_mass: total,
+                max_factor,
+                max_factor_element: max_cell.map(|c| mesh.cells[c].tag).unwrap_or(0),
+            }
+        });
+        // without a scaled element the inertia is the unscaled mass (and no separate weight)
+        let scaled = mass_scaling.as_ref().is_some_and(|m| m.scaled_elements > 0);
+        if !scaled {
+            inertial = Vec::new();
+            mass_scale = Vec::new();
+        }
         let mass_damped = match &scene.damping.mass_groups {
             None => vec![true; n],
             Some(groups) => {
@@ -507,9 +582,10 @@ impl Model {
             tets,
             hexes,
             mass: {
-                // the layer of a massless block along a joint: inertia, no weight
-                let weight: Option<Vec<f64>> = weightless.iter().any(|&w| w).then(|| mass.iter().zip(&weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect());
-                let mut m = NodalMass::lumped(mass);
+                // the layer of a massless block along a joint: inertia, no weight; scaled
+                // elements: their weight is their unscaled mass
+                let weight: Option<Vec<f64>> = (scaled || weightless.iter().any(|&w| w)).then(|| mass.iter().zip(&weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect());
+                let mut m = NodalMass::lumped(if scaled { inertial } else { mass });
                 if let Some(g) = weight {
                     m.set_gravitational(g);
                 }
@@ -520,11 +596,13 @@ impl Model {
             alpha,
             mass_damped,
             beta,
-            critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0, scaled_jacobian: 1.0, step_ratio: 1.0 },
+            critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0, scaled_jacobian: 1.0, step_ratio: 1.0, mass_factor: 1.0 },
             massless,
             massless_cells: element_massless_cell,
             condensed,
             weightless,
+            mass_scale,
+            mass_scaling,
         };
         model.critical = model.max_element_eigenvalue();
         Ok(model)
@@ -581,7 +659,7 @@ impl Model {
                 let m = &self.materials[self.tets.mat[e] as usize];
                 let g = &self.tets.geom[e];
                 // a massless element (ρ = 0) sets no stable step: its nodes are condensed statically
-                if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) } else { 0.0 }
+                if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) / self.scale_of(self.tets.cell[e]) } else { 0.0 }
             })
             .collect();
         let mut t = (0.0, 0, 0);
@@ -614,7 +692,7 @@ impl Model {
             if pure_massless(self.hexes.cell[e]) {
                 continue;
             }
-            let w = shape_omega[self.hexes.shape[e] as usize];
+            let w = shape_omega[self.hexes.shape[e] as usize] / self.scale_of(self.hexes.cell[e]);
             let c = self.hexes.cell[e] as usize;
             if w > best.0 || (w == best.0 && c < best.1) {
                 best = (w, c, self.hexes.mat[e] as usize);
@@ -636,12 +714,19 @@ impl Model {
         }
         for e in 0..self.hexes.nodes.len() {
             if self.hexes.mat[e] as usize == best.2 && !pure_massless(self.hexes.cell[e]) {
-                add(shape_omega[self.hexes.shape[e] as usize]);
+                add(shape_omega[self.hexes.shape[e] as usize] / self.scale_of(self.hexes.cell[e]));
             }
         }
         let step_ratio = if best.0 > 0.0 && count > 0 { (2.0 / best.0.sqrt()) / (sum / count as f64) } else { 1.0 };
         let scaled_jacobian = crate::mesh::quality::cell_scaled_jacobian(&self.mesh, best.1).unwrap_or(1.0);
-        CriticalElement { tag: self.mesh.cells[best.1].tag, group: self.materials[best.2].group.clone(), omega2: best.0, scaled_jacobian, step_ratio }
+        let mass_factor = self.scale_of(best.1 as u32);
+        CriticalElement { tag: self.mesh.cells[best.1].tag, group: self.materials[best.2].group.clone(), omega2: best.0, scaled_jacobian, step_ratio, mass_factor }
+    }
+
+    /// The inertial density factor of mesh cell `cell` (1 without mass scaling).
+    #[inline]
+    fn scale_of(&self, cell: u32) -> f64 {
+        self.mass_scale.get(cell as usize).copied().unwrap_or(1.0)
     }
 
     /// Stable time step [s] of the central-difference scheme with Rayleigh damping:

@@ -261,6 +261,7 @@ impl Recorder {
             critical_group: model.critical.group.clone(),
             critical_scaled_jacobian: Some(model.critical.scaled_jacobian),
             critical_step_ratio: Some(model.critical.step_ratio),
+            mass_scaling: model.mass_scaling.clone(),
             steps: sim.n_steps(),
             duration: scene.time.duration,
             threads: rayon::current_num_threads(),
@@ -287,15 +288,18 @@ impl Recorder {
     }
 
     /// What the run got through but should not be trusted without a look: a sliver setting the
-    /// stable step ([`crate::mesh::quality::SLIVER_SCALED_JACOBIAN`]), lost contact
+    /// stable step ([`crate::mesh::quality::SLIVER_SCALED_JACOBIAN`]), mass scaling that added
+    /// more than [`crate::model::mass_scaling::ADDED_MASS_WARN_FRACTION`] of the mass, lost contact
     /// ([`LOST_WARN_FRACTION`]), an unconverged Gauss–Seidel ([`GS_WARN_FACTOR`]), NTN on a
     /// non-conforming joint ([`NTN_WARN_FRACTION`]).
     fn warnings(&self, sim: &Simulation<'_>) -> Vec<String> {
         let mut w = Vec::new();
         let c = &sim.problem.model.critical;
-        if c.is_sliver() {
+        w.extend(sim.problem.model.mass_scaling.as_ref().and_then(|m| m.warning()));
+        // a sliver whose inertia was scaled sets the scaling's target step, not its own
+        if c.is_sliver() && c.mass_factor == 1.0 {
             w.push(format!(
-                "the stable step is set by a sliver: element {} in \"{}\" has a scaled Jacobian of {:.3} (below {}) and a step {:.2} × its block's mean element step; a better shaped mesh would allow a larger step (gmsh: Mesh.Optimize 1, Mesh.OptimizeNetgen 1; docs/elements.md, \"Mesh quality\")",
+                "the stable step is set by a sliver: element {} in \"{}\" has a scaled Jacobian of {:.3} (below {}) and a step {:.2} × its block's mean element step; a better shaped mesh would allow a larger step (gmsh: Mesh.Algorithm3D = 10 (HXT), or Mesh.OptimizeNetgen = 1 with the default Delaunay; else time.mass_scaling; docs/elements.md, \"Mesh quality\")",
                 c.tag,
                 c.group,
                 c.scaled_jacobian,

@@ -37,6 +37,11 @@ pub struct RunSummary {
     /// The critical element's step 2/ω over the mean element step of its block; `None` before.
     #[serde(default)]
     pub critical_step_ratio: Option<f64>,
+    /// What `time.mass_scaling` did (scaled elements, added mass and its fraction of the total,
+    /// largest factor: docs/elements.md "Mass scaling"); `None` without it (and in summaries
+    /// written before it).
+    #[serde(default)]
+    pub mass_scaling: Option<crate::model::mass_scaling::MassScaling>,
     pub steps: usize,
     pub duration: f64,
     pub threads: usize,

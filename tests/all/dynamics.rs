@@ -246,3 +246,173 @@ fn massless_nodes_are_held_and_set_no_stable_step() {
     let diff = (0..alone.model.n_nodes() * 3).map(|i| (a.u[i] - b.u[i]).abs()).fold(0.0, f64::max);
     assert!(scale > 0.0 && diff < 1e-12 * scale, "massive box differs by {diff:e} of {scale:e}");
 }
+
+/// The prism of [`wave_in_prism_matches_dalembert`] with the section at x = 5 m moved 0.1 m
+/// towards the load's far end: element 24 is 0.1 m long (half the others, half their step),
+/// element 25 0.3 m.
+fn prism_with_a_short_element() -> jointquake::mesh::Mesh {
+    let mut mesh = box_mesh(&BoxSpec::new("prism", [10.0, 1.0, 1.0], [50, 1, 1]));
+    for x in mesh.nodes.iter_mut() {
+        if (x[0] - 5.0).abs() < 1e-9 {
+            x[0] = 4.9;
+        }
+    }
+    mesh
+}
+
+/// Issue 19, mass scaling's error measured (docs/elements.md "Mass scaling"). The d'Alembert
+/// wave of [`wave_in_prism_matches_dalembert`] (σ0 step at x = L, fixed at 0, ν = 0: the end
+/// displacement is a triangle of peak 2σ0L/E over 0 … 4L/c) on the prism with one short
+/// element, run (1) unscaled, at 0.9 of its step (set by the short element), and (2) with
+/// `time.mass_scaling` to 0.7 × the regular elements' step: only the short element is scaled,
+/// by s ≈ 2, and the step grows by about 1.4. Reference for the tolerance: a heavier segment of
+/// length l acts on a wave like a lumped mass (s − 1) ρ A l: it reflects a pulse of displacement
+/// v0 τ, τ = (s − 1) l / (2c) (doubled at the loaded end, a free end for the reflection: v0 (s − 1)
+/// l / c = ½ f of the peak 2 v0 L / c, with f = (s − 1) l / L the added mass fraction), and
+/// delays the transmitted wave by (l/c)(√s − 1) ≤ τ (another ≤ ½ f once back at the end). So the
+/// end's displacement changes by at most about f of the peak. Tolerance: the scaled run's worst
+/// deviation from d'Alembert may exceed the unscaled one's by at most f × peak. Measured: the
+/// short element scaled by 1.96 (0.96 % added mass), the step 1.40× larger, the worst deviation
+/// 1.056 % of the peak unscaled and 1.284 % scaled: +0.23 % against the tolerance 0.96 %
+/// (docs/elements.md "Mass scaling").
+#[test]
+fn mass_scaling_error_on_the_wave_is_within_the_added_mass_fraction() {
+    let (l, e, rho, s0): (f64, f64, f64, f64) = (10.0, 1e9, 2000.0, 1e6);
+    let c = (e / rho).sqrt();
+    let v0 = s0 / (rho * c);
+    let peak = 2.0 * s0 * l / e;
+    let base = json!({
+        "geometry": {"msh": "unused.msh"},
+        "materials": [{"group": "block:prism", "E": e, "nu": 0.0, "rho": rho}],
+        "boundary": [{"group": "prism:x0"}],
+        "loads": {"traction": [{"group": "prism:x1", "traction": [s0, 0.0, 0.0]}]},
+        "time": {"duration": 1.0}
+    });
+    // the regular elements' step: that of the uniform prism
+    let t_reg = problem(box_mesh(&BoxSpec::new("prism", [l, 1.0, 1.0], [50, 1, 1])), &scene(base.clone()), 0.9).model.stable_dt();
+    let worst_of = |sc: serde_json::Value| -> (f64, f64, Option<jointquake::model::mass_scaling::MassScaling>) {
+        let mesh = prism_with_a_short_element();
+        let end = mesh.group_nodes("prism:x1").unwrap();
+        let pb = problem(mesh, &scene(sc), 0.9);
+        let dt = 0.9 * pb.model.stable_dt();
+        let steps = (4.0 * l / c / dt) as usize;
+        let mut worst: f64 = 0.0;
+        simulate(&pb, steps, |t, u| {
+            let exact = if t < 2.0 * l / c { v0 * t } else { v0 * (4.0 * l / c - t) };
+            worst = worst.max((mean_u(u, &end, 0) - exact).abs());
+        });
+        (worst, dt, pb.model.mass_scaling.clone())
+    };
+    let (w0, dt0, none) = worst_of(base.clone());
+    assert!(none.is_none());
+    let mut scaled = base.clone();
+    scaled["time"]["mass_scaling"] = json!({"target_dt": 0.9 * 0.7 * t_reg});
+    let (w1, dt1, ms) = worst_of(scaled);
+    let ms = ms.expect("scaled");
+    let f = ms.added_fraction();
+    eprintln!(
+        "wave with a short element: unscaled dt {dt0:.4e} s, worst {:.3} % of the peak; scaled (1 element × {:.3}, added {:.3} % of the mass) dt {dt1:.4e} s ({:.2} ×), worst {:.3} % of the peak; change {:+.3} % (tolerance {:.3} %)",
+        100.0 * w0 / peak, ms.max_factor, 100.0 * f, dt1 / dt0, 100.0 * w1 / peak, 100.0 * (w1 - w0) / peak, 100.0 * f
+    );
+    assert_eq!(ms.scaled_elements, 1, "only the short element");
+    assert!((dt1 - 0.9 * 0.7 * t_reg).abs() < 1e-9 * dt1, "the step reaches the target");
+    assert!(dt1 > 1.3 * dt0, "the step grows: {dt1} vs {dt0}");
+    assert!(w1 - w0 <= f * peak, "error change {:.3} % of the peak above the added fraction {:.3} %", 100.0 * (w1 - w0) / peak, 100.0 * f);
+}
+
+/// Issue 19, mass scaling keeps the weight: gravity acts on the unscaled (gravitational) mass.
+/// (1) sliver_tet.msh under gravity with `time.mass_scaling` to the unaltered mesh's step: the
+/// external force of every node equals the unscaled model's, and their sum is ρ g V (V summed
+/// from the element volumes), to 1e-12 relative. (2) A gravity column (as
+/// [`gravity_column_stress_after_equilibrium`]) with one thin element layer (0.3 m of 0.5 m), its
+/// step raised 1.2× (measured: its 4 elements scaled, 1.32 % added mass), relaxed to 1e-8: the
+/// base reaction Σ (K u − F)_z equals ρ g V (the weight) to 1e-6 relative (the relaxation's
+/// tolerance with margin), and the displacement field the unscaled one's (static: the mass does
+/// not enter) to 1e-6 of its peak.
+#[test]
+fn mass_scaling_leaves_the_weight_and_the_static_state_unchanged() {
+    use jointquake::dynamics::loads::Loads;
+    use jointquake::model::Model;
+    let fixture = crate::common::fixture("sliver_tet.msh");
+    let base = json!({
+        "geometry": {"msh": fixture},
+        "materials": [
+            {"group": "block:lower", "E": 30e9, "nu": 0.2, "rho": 2400},
+            {"group": "block:upper", "E": 30e9, "nu": 0.2, "rho": 2400}
+        ],
+        "boundary": [{"group": "bc:base"}],
+        "loads": {"gravity": {"g": 9.81}},
+        "time": {"duration": 0.0}
+    });
+    let model0 = Model::build(jointquake::mesh::Mesh::from_msh(&fixture).unwrap(), &scene(base.clone())).unwrap();
+    // target: the unaltered boxes_tet.msh's step (measured: only the sliver is below it, factor 98)
+    let mut unaltered = base.clone();
+    unaltered["geometry"]["msh"] = json!(crate::common::fixture("boxes_tet.msh"));
+    let regular = Model::build(jointquake::mesh::Mesh::from_msh(crate::common::fixture("boxes_tet.msh")).unwrap(), &scene(unaltered)).unwrap().stable_dt();
+    let mut sc = base.clone();
+    sc["time"]["mass_scaling"] = json!({"target_dt": 0.9 * regular});
+    let model1 = Model::build(jointquake::mesh::Mesh::from_msh(&fixture).unwrap(), &scene(sc.clone())).unwrap();
+    let ms = model1.mass_scaling.clone().unwrap();
+    assert!(ms.scaled_elements >= 1 && ms.added_fraction() > 0.0, "{ms:?}");
+    eprintln!("sliver_tet.msh scaled to the regular step: {} elements, added {:.3} %", ms.scaled_elements, 100.0 * ms.added_fraction());
+    let force = |m: &Model, s: &serde_json::Value| {
+        let (loads, _) = Loads::build(m, &scene(s.clone())).unwrap();
+        let mut f = vec![0.0; 3 * m.n_nodes()];
+        loads.external_force_into(m, 0.0, true, false, &mut f);
+        f
+    };
+    let (f0, f1) = (force(&model0, &base), force(&model1, &sc));
+    let fmax = f0.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    let diff = f0.iter().zip(&f1).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+    assert!(diff <= 1e-12 * fmax, "nodal gravity forces differ by {diff:e} (max {fmax:e})");
+    let volume: f64 = model1.tets.geom.iter().map(|g| g.vol).sum();
+    let weight = 2400.0 * 9.81 * volume;
+    let fz: f64 = f1.iter().skip(2).step_by(3).sum();
+    assert!((fz + weight).abs() <= 1e-12 * weight, "Σ f_z {fz} vs −ρgV {}", -weight);
+    let inertia = model1.mass.total_along(&nalgebra::Vector3::z());
+    assert!((inertia - (1.0 + ms.added_fraction()) * weight / 9.81).abs() < 1e-12 * inertia, "the inertia is scaled: {inertia}");
+
+    // (2) a relaxed column with a thin layer
+    let (rho, g, h): (f64, f64, f64) = (2500.0, 9.81, 10.0);
+    let column = || {
+        let mut mesh = box_mesh(&BoxSpec::new("col", [1.0, 1.0, h], [2, 2, 20]));
+        for x in mesh.nodes.iter_mut() {
+            if (x[2] - 5.0).abs() < 1e-9 {
+                x[2] = 4.8;
+            }
+        }
+        mesh
+    };
+    let col = json!({
+        "geometry": {"msh": "unused.msh"},
+        "materials": [{"group": "block:col", "E": 1e9, "nu": 0.25, "rho": rho}],
+        "boundary": [{"group": "col:z0", "fix": ["z"]}, {"group": "col:x0", "fix": ["x"]}, {"group": "col:y0", "fix": ["y"]}],
+        "loads": {"gravity": {"g": g}},
+        "time": {"duration": 0.0}
+    });
+    let relaxed = |sc: serde_json::Value| {
+        let pb = problem(column(), &scene(sc), 0.9);
+        let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
+        let eq = sim.relax(1e-8, 400_000).unwrap();
+        assert!(eq.converged, "{eq:?}");
+        let mut fi = vec![0.0; sim.state.u.len()];
+        pb.model.internal_forces_into(&sim.state.u, &mut fi);
+        let mut fe = vec![0.0; sim.state.u.len()];
+        pb.loads.external_force_into(&pb.model, 0.0, true, false, &mut fe);
+        let base_nodes = pb.model.mesh.group_nodes("col:z0").unwrap();
+        let reaction: f64 = base_nodes.iter().map(|&n| fi[3 * n + 2] - fe[3 * n + 2]).sum();
+        (sim.state.u.clone(), reaction, pb.model.stable_dt(), pb.model.mass_scaling.clone())
+    };
+    let (u0, r0, dt0, _) = relaxed(col.clone());
+    let mut cs = col.clone();
+    cs["time"]["mass_scaling"] = json!({"target_dt": 0.9 * 1.2 * dt0});
+    let (u1, r1, dt1, ms) = relaxed(cs);
+    let ms = ms.unwrap();
+    assert!(ms.scaled_elements > 0 && (dt1 - 1.2 * dt0).abs() < 1e-9 * dt1, "{ms:?}, {dt1} vs {dt0}");
+    let w = rho * g * h;
+    eprintln!("column: reaction {r0:.6e} N unscaled, {r1:.6e} N scaled, weight {w:.6e} N; {} elements scaled, added {:.3} %", ms.scaled_elements, 100.0 * ms.added_fraction());
+    assert!((r0 - w).abs() < 1e-6 * w && (r1 - w).abs() < 1e-6 * w, "reactions {r0} {r1} vs {w}");
+    let umax = u0.iter().fold(0.0f64, |a, b| a.max(b.abs()));
+    let du = u0.iter().zip(&u1).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+    assert!(du < 1e-6 * umax, "static states differ by {du:e} (peak {umax:e})");
+}

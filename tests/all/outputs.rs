@@ -856,3 +856,68 @@ fn sliver_setting_the_stable_step_is_named_with_its_quality() {
     let e = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).err().expect("refused").to_string();
     assert!(e.contains(&format!("element {}", bad.critical_element)) && e.contains(&format!("scaled Jacobian {q:.3}")) && e.contains("a sliver"), "{e}");
 }
+
+/// Issue 19 (mass scaling, docs/elements.md "Mass scaling"): `time.mass_scaling.target_dt`
+/// raises the inertial density of every element whose own step 2/ω_e is below
+/// T = target_dt / courant by s = (T / (2/ω_e))² (λ_max ∝ 1/ρ), so that the model's stable step
+/// becomes T and the run's step target_dt. Reference: the element steps of the unscaled model
+/// (`tet4::max_eigenvalue`, the bound `Model::stable_dt` uses), the count and the added mass
+/// Σ (s − 1) ρ V summed here independently of the build. Tolerances: 1e-9 relative (round-off
+/// of ω²/s; the formula is exact). Two targets on sliver_tet.msh: between the sliver's step and
+/// the next element's (only the sliver is scaled, a small added mass, no warning), and just
+/// above the median element step (half the elements scaled: added mass above 1 %, a warning). The sliver warning is not given once the sliver is scaled (its step is the
+/// target's).
+#[test]
+fn mass_scaling_raises_the_sliver_step_to_the_target() {
+    use jointquake::model::tet4;
+    let sc0: jointquake::scene::Scene = serde_json::from_value(boxes_tet_scene("sliver_tet.msh")).unwrap();
+    let model = Model::build(Mesh::from_msh(fixture("sliver_tet.msh")).unwrap(), &sc0).unwrap();
+    // (element step 2/ω, volume, tag) of every tet, ascending by step
+    let mut el: Vec<(f64, f64, u64)> = (0..model.tets.nodes.len())
+        .map(|e| {
+            let (g, m) = (&model.tets.geom[e], &model.materials[model.tets.mat[e] as usize]);
+            (2.0 / tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame).sqrt(), g.vol, model.mesh.cells[model.tets.cell[e] as usize].tag)
+        })
+        .collect();
+    el.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let rho = 2400.0;
+    let total: f64 = el.iter().map(|e| rho * e.1).sum();
+    assert_eq!(el[0].2, model.critical.tag, "the sliver sets the unscaled step");
+    let courant = 0.9;
+    // targets between two distinct element steps (congruent elements share a step)
+    let median = el[el.len() / 2].0;
+    let above_median = el.iter().map(|e| e.0).find(|&t| t > median * (1.0 + 1e-9)).expect("a larger step");
+    for (k, t_elem) in [(el[0].0 * el[1].0).sqrt(), (median * above_median).sqrt()].into_iter().enumerate() {
+        let target = courant * t_elem;
+        let below: Vec<&(f64, f64, u64)> = el.iter().filter(|e| e.0 < t_elem).collect();
+        let added: f64 = below.iter().map(|e| ((t_elem / e.0).powi(2) - 1.0) * rho * e.1).sum();
+        let dir = scratch(&format!("outputs/mass_scaling_{k}"));
+        let mut sc = boxes_tet_scene("sliver_tet.msh");
+        sc["time"]["mass_scaling"] = json!({"target_dt": target});
+        let p = write_scene(&dir, &sc);
+        let s = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).expect("runs");
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+        assert!(rel(s.dt_stable, t_elem) < 1e-9, "stable step {} vs target/courant {t_elem}", s.dt_stable);
+        assert!(rel(s.dt, target) < 1e-9, "step {} vs target {target}", s.dt);
+        let ms = s.mass_scaling.as_ref().expect("reported");
+        assert_eq!(ms.scaled_elements, below.len());
+        assert!(rel(ms.added_mass, added) < 1e-9, "added {} vs {added}", ms.added_mass);
+        assert!(rel(ms.total_mass, total) < 1e-12, "total {} vs {total}", ms.total_mass);
+        assert_eq!(ms.max_factor_element, el[0].2, "the sliver has the largest factor");
+        assert!(rel(ms.max_factor, (t_elem / el[0].0).powi(2)) < 1e-9, "factor {}", ms.max_factor);
+        eprintln!("mass scaling case {k}: target {target:.4e} s, {} elements scaled, added {:.4e} kg = {:.4} % of {total:.4e} kg, largest factor {:.2}", ms.scaled_elements, ms.added_mass, 100.0 * ms.added_fraction(), ms.max_factor);
+        assert!(s.notes.iter().any(|n| n.contains("mass scaling") && n.contains(&format!("{} element{} scaled", below.len(), if below.len() == 1 { "" } else { "s" }))), "{:?}", s.notes);
+        assert!(s.warnings.iter().all(|w| !w.contains("sliver")), "{:?}", s.warnings);
+        let warned = s.warnings.iter().any(|w| w.contains("mass scaling added") && w.contains("above 1 %"));
+        assert_eq!(warned, added / total > 0.01, "warning iff the added mass exceeds 1 % ({:.3} %): {:?}", 100.0 * added / total, s.warnings);
+        if k == 0 {
+            assert_eq!(below.len(), 1, "only the sliver");
+            assert!(!warned);
+        } else {
+            assert!(warned, "half the elements scaled: {:.3} %", 100.0 * added / total);
+        }
+        // summary.json carries it
+        let back = jointquake::output::summary::RunSummary::read(&dir.join("out")).unwrap();
+        assert_eq!(back.mass_scaling.as_ref(), Some(ms));
+    }
+}
