@@ -106,18 +106,15 @@ pub fn self_weight_open_joints(problem: &Problem) -> Result<(Vec<f64>, StageRepo
 /// offset becomes its gap there. Returns the stage's report (largest |offset|, pairs without
 /// a master face).
 pub fn grout(problem: &Problem, contact: &mut ContactState, u: &[f64]) -> Result<StageReport, Error> {
-    grout_pairs(problem, contact, u, |_, _| true)
+    grout_pairs(problem, contact, u, |ji, _| !problem.joints[ji].law.tied)
 }
 
-/// Grout the pairs (joint, slave index) for which `which` holds, of every joint that is not
-/// tied, at the displacements `u` (as [`grout`]).
+/// Grout the pairs (joint, slave index) for which `which` holds at the displacements `u` (as
+/// [`grout`]; a tied joint's pair too when `which` takes it: its tie then holds that gap).
 pub fn grout_pairs(problem: &Problem, contact: &mut ContactState, u: &[f64], which: impl Fn(usize, usize) -> bool) -> Result<StageReport, Error> {
     let model = &problem.model;
     let (mut pairs, mut missed, mut largest) = (0usize, 0usize, 0.0f64);
     for (ji, j) in problem.joints.iter().enumerate() {
-        if j.law.tied {
-            continue;
-        }
         let m = &j.tag.master;
         let pos = |node: usize| Vector3::new(model.mesh.nodes[node][0] + u[3 * node], model.mesh.nodes[node][1] + u[3 * node + 1], model.mesh.nodes[node][2] + u[3 * node + 2]);
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
@@ -195,7 +192,12 @@ pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
             // the closed pairs carry the penalty's small penetration (info.max_penetration);
             // the explicit run's contact is exact and would push it out in one step, so they
             // are re-grouted where they are: the dynamic stage starts with them touching.
-            let closed: Vec<Vec<bool>> = sim.state.contact.joints.iter().map(|j| j.pairs.iter().map(|r| r.state != crate::contact::law::PairState::Open).collect()).collect();
+            // The tied joints too: the static solves tie each slave to its master point with
+            // the gap it was meshed with (`bonded`: u_s = Σ N_I u_I), while an explicit tie
+            // holds the gap offset, 0 until grouted, and would close the meshed gap (the
+            // chords of non-conforming tied joints) in the first step (regression
+            // `dam_ties_keep_their_meshed_gap_when_released`).
+            let closed: Vec<Vec<bool>> = sim.state.contact.joints.iter().enumerate().map(|(ji, j)| j.pairs.iter().map(|r| p.joints[ji].law.tied || r.state != crate::contact::law::PairState::Open).collect()).collect();
             grout_pairs(p, &mut sim.state.contact, &sim.state.u, |ji, i| closed[ji][i])?;
             // (grouting sets only the offsets: the pairs keep their forces and states; a
             // closed pair's gap is 0 from here)
@@ -219,9 +221,14 @@ pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
             sim.equilibrium = Some(EquilibriumInfo { steps: eq.steps, residual: eq.residual, converged: eq.converged });
         }
         _ => {
+            let zero = vec![0.0; sim.state.u.len()];
             if sequence == "grouted" {
-                let zero = vec![0.0; sim.state.u.len()];
                 stages.push(grout(p, &mut sim.state.contact, &zero)?);
+            }
+            // a tie holds the gap it was meshed with, as in the static solves (`bonded`) and
+            // in the construction sequence above
+            if p.joints.iter().any(|j| j.law.tied) {
+                grout_pairs(p, &mut sim.state.contact, &zero, |ji, _| p.joints[ji].law.tied)?;
             }
             if let Some(eq) = sim.equilibrate()? {
                 stages.push(StageReport { name: "all loads, joints in contact".into(), method: "relaxation".into(), residual: eq.residual, steps: eq.steps, note: String::new() });

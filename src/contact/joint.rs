@@ -106,29 +106,37 @@ impl ContactJoint {
     }
 }
 
-/// The slave nodes of the tied joints, ascending (empty without tied joints).
+/// Per joint (scene order), its slave nodes whose pairs are **not formed**, ascending.
 ///
 /// The rule, written once here: **a node that is the slave of a tied joint is the slave of no
 /// other joint**; a pair of another joint on it is not formed (the dynamic contact force,
 /// `force::ContactSolver`, and the static contact of the construction sequence,
-/// `static_contact`; the bonded joints of the linear analyses keep the tied constraint of such a
-/// node, `bonded`). Why: the tie already fixes the node's motion (to the rock, on the dam's
-/// base), so a second constraint on it is redundant — at a contraction joint's bottom edge,
-/// where the two monoliths meet the tied base, nearly so: the slave's master point lies on the
-/// bottom edge of a master face whose bottom nodes are tied too, so the pair holds the face's
-/// upper nodes through weights near 0. Such pairs fought the ties: the coarse dam's NTN joints
-/// (slave and O both on the base) grew a motion from rest, ×1.8 a step, until the energy check
-/// stopped them at step 70 (regression `dam_ntn_static_state_stays_at_rest`); the NTS pairs
-/// on the bottom edge made the Gauss–Seidel sweeps crawl (about 0.5 % a sweep: the dam study's
-/// NTS runs hit the 200-sweep cap in 2 steps out of 3; 5 sweeps a step without them,
-/// regression `dam_gauss_seidel_converges_without_the_pairs_on_tied_nodes`).
-pub fn tied_slave_nodes(joints: &[ContactJoint]) -> Vec<u32> {
-    let mut nodes: Vec<u32> = joints.iter().filter(|j| j.law.tied).flat_map(|j| j.tag.slave_nodes().iter().map(|&n| n as u32)).collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    nodes
+/// `static_contact`; the linear analyses, `bonded`, eliminate the ties exactly and need no
+/// rule). A node that is the slave of several tied joints keeps the tie of the **last** of
+/// them in scene order (the dam scenes list the contraction joints first and the dam–rock base
+/// last, so a monolithic dam's base nodes stay tied to the rock, whose reactions the reports
+/// read). Why: the tie already fixes the node's motion, so a second constraint on it is
+/// redundant — at a contraction joint's bottom edge, where the two monoliths meet the tied
+/// base, nearly so: the slave's master point lies on the bottom edge of a master face whose
+/// bottom nodes are tied too, so the pair holds the face's upper nodes through weights near 0.
+/// Such pairs fought the ties: the coarse dam's NTN joints (slave and O both on the base) grew a
+/// motion from rest, ×1.8 a step, until the energy check stopped them at step 70 (regression
+/// `dam_ntn_static_state_stays_at_rest`); the NTS pairs on the bottom edge made the
+/// Gauss–Seidel sweeps crawl (about 0.5 % a sweep: the dam study's NTS runs hit the 200-sweep
+/// cap in 2 steps out of 3; 5 sweeps a step without them, regression
+/// `dam_gauss_seidel_converges_without_the_pairs_on_tied_nodes`), and the monolithic dam's
+/// tied contraction joints on the tied base did the same until its 3× runs lost their energy
+/// balance (regression `monolithic_dam_ties_each_base_node_once`).
+pub fn unformed_slave_nodes(joints: &[ContactJoint]) -> Vec<Vec<u32>> {
+    let tied_after = |from: usize| {
+        let mut nodes: Vec<u32> = joints[from..].iter().filter(|j| j.law.tied).flat_map(|j| j.tag.slave_nodes().iter().map(|&n| n as u32)).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+    };
+    let all = tied_after(0);
+    (0..joints.len()).map(|ji| if joints[ji].law.tied { tied_after(ji + 1) } else { all.clone() }).collect()
 }
-
 
 /// The joints stage: tag every joint of the scene on the mesh (once, on the initial
 /// configuration) and resolve its law and options, in scene order. The default tagging
