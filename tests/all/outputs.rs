@@ -798,6 +798,34 @@ fn gauss_seidel_cap_reports_the_residual_and_warns() {
     assert!(s.to_text().contains("residual up to"));
 }
 
+/// Regression: the joints' pairs are swept together, so when the sweeps stop at the cap every
+/// joint reports the same steps and residual, and the coarse dam's summary repeated the same
+/// Gauss–Seidel warning 28 times. Now one line names the joints that share it. The coarse dam
+/// (pipelines/dam_coarse.json, 28 joints and the tied base) with the cap forced to 1 sweep,
+/// released under gravity for 10 steps: exactly one Gauss–Seidel warning, naming J01 and J28.
+#[test]
+fn gauss_seidel_warning_is_one_line_for_joints_swept_together() {
+    use jointquake::output::recorder::Recorder;
+    use jointquake::problem::Problem;
+    use jointquake::simulation::Simulation;
+    let dir = scratch("outputs/gs_cap_dam");
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam_coarse.json");
+    let mut sc = jointquake::scene::Scene::load(&path).unwrap();
+    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
+    jointquake::pipeline::expand_patterns(&mut sc, &mesh, &path).unwrap();
+    sc.loads.base.clear();
+    let problem = Problem::build(sc, mesh).unwrap();
+    let mut sim = Simulation::new(&problem).unwrap();
+    sim.contact.as_mut().unwrap().gs_max_sweeps = 1;
+    let n = 10;
+    let mut rec = Recorder::create(&sim, &dir.join("out"), false).unwrap();
+    sim.run_steps(n, &mut rec).unwrap();
+    let s = rec.summary(&sim, PathBuf::new(), vec![], 0.0);
+    let gs: Vec<&String> = s.warnings.iter().filter(|w| w.contains("Gauss–Seidel stopped")).collect();
+    assert_eq!(gs.len(), 1, "{gs:?}");
+    assert!(gs[0].contains("J01") && gs[0].contains("J28") && gs[0].contains("swept together"), "{}", gs[0]);
+}
+
 /// A scene on a tet fixture (the boxes, no joint: the step is the elements' alone).
 fn boxes_tet_scene(msh: &str) -> Value {
     json!({
