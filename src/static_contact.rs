@@ -88,7 +88,7 @@ pub struct StaticContactInfo {
     pub open: usize,
     pub left_out: usize,
     /// Pairs not formed because their slave node is the slave of a tied joint
-    /// (`contact::joint::unformed_slave_nodes`).
+    /// (`contact::joint::unformed_pairs`).
     pub on_tied: usize,
     /// Pairs held closed because they kept opening and closing.
     pub held: usize,
@@ -177,14 +177,14 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let mut info = StaticContactInfo::default();
     // the pairs
     let mut pairs = Vec::new();
-    let unformed = crate::contact::joint::unformed_slave_nodes(&problem.joints);
+    let unformed = crate::contact::joint::unformed_pairs(&problem.joints);
     for (ji, j) in problem.joints.iter().enumerate() {
         if j.law.tied {
             continue;
         }
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
-            if unformed[ji].binary_search(&(s as u32)).is_ok() {
-                // the slave of a tied joint is the slave of no other joint (the rule: `unformed_slave_nodes`)
+            if unformed[ji][i] {
+                // the slave of a tied joint is the slave of no other joint (the rule: `unformed_pairs`)
                 info.on_tied += 1;
                 continue;
             }

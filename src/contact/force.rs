@@ -208,9 +208,9 @@ pub struct ContactSolver<'m> {
     mob_matrix: Vec<[Matrix3<f64>; 5]>,
     /// The free nodes with a 3×3 inertia block, ascending (empty for most models).
     block_nodes: Vec<u32>,
-    /// Per joint, the slave nodes whose pairs are not formed, ascending
-    /// (`joint::unformed_slave_nodes`: the slaves of tied joints).
-    unformed: Vec<Vec<u32>>,
+    /// Per joint and slave node, whether its pair is not formed (`joint::unformed_pairs`: the
+    /// slaves of tied joints).
+    unformed: Vec<Vec<bool>>,
     cand: Vec<u32>,
     /// Per model node, its place among the local nodes (see [`NodeScratch`]).
     node: Vec<NodeScratch>,
@@ -242,7 +242,7 @@ impl<'m> ContactSolver<'m> {
             let n = b.node as usize;
             inv_mass[n] = if movable(n) { b.inverse.symmetric_eigenvalues().max().max(0.0) } else { 0.0 };
         }
-        let unformed = super::joint::unformed_slave_nodes(joints);
+        let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
         ContactSolver { block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
@@ -753,9 +753,9 @@ impl ContactSolver<'_> {
                     }
                 };
                 // A pair whose slave node is the slave of a (later) tied joint is not formed
-                // (`joint::unformed_slave_nodes`: the tie fixes the node): reported bonded, with
-                // no force of its own.
-                if self.unformed[ji].binary_search(&(s as u32)).is_ok() {
+                // (`joint::unformed_pairs`: the tie fixes the node): reported bonded, with no
+                // force of its own.
+                if self.unformed[ji][i] {
                     let p = &mut rec.pairs[i];
                     p.state = PairState::Bonded;
                     p.r_n = 0.0;

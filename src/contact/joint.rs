@@ -106,7 +106,8 @@ impl ContactJoint {
     }
 }
 
-/// Per joint (scene order), its slave nodes whose pairs are **not formed**, ascending.
+/// Per joint (scene order) and slave node (the tag's order): whether its pair is **not
+/// formed**.
 ///
 /// The rule, written once here: **a node that is the slave of a tied joint is the slave of no
 /// other joint**; a pair of another joint on it is not formed (the dynamic contact force,
@@ -127,15 +128,15 @@ impl ContactJoint {
 /// `dam_gauss_seidel_converges_without_the_pairs_on_tied_nodes`), and the monolithic dam's
 /// tied contraction joints on the tied base did the same until its 3× runs lost their energy
 /// balance (regression `monolithic_dam_ties_each_base_node_once`).
-pub fn unformed_slave_nodes(joints: &[ContactJoint]) -> Vec<Vec<u32>> {
-    let tied_after = |from: usize| {
-        let mut nodes: Vec<u32> = joints[from..].iter().filter(|j| j.law.tied).flat_map(|j| j.tag.slave_nodes().iter().map(|&n| n as u32)).collect();
-        nodes.sort_unstable();
-        nodes.dedup();
-        nodes
-    };
-    let all = tied_after(0);
-    (0..joints.len()).map(|ji| if joints[ji].law.tied { tied_after(ji + 1) } else { all.clone() }).collect()
+pub fn unformed_pairs(joints: &[ContactJoint]) -> Vec<Vec<bool>> {
+    // per node, the last tied joint (scene order) it is a slave of
+    let mut last_tie: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
+    for (ji, j) in joints.iter().enumerate().filter(|(_, j)| j.law.tied) {
+        for &s in j.tag.slave_nodes() {
+            last_tie.insert(s, ji);
+        }
+    }
+    joints.iter().enumerate().map(|(ji, j)| j.tag.slave_nodes().iter().map(|s| last_tie.get(s).is_some_and(|&t| t != ji)).collect()).collect()
 }
 
 /// The joints stage: tag every joint of the scene on the mesh (once, on the initial
