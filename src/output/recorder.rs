@@ -309,7 +309,8 @@ impl Recorder {
         }
         let Some(jw) = self.joints.as_ref() else { return w };
         let steps = self.stop.unwrap_or(sim.n_steps()).max(1) as f64;
-        let mut gs: Vec<((u64, u64, u64), Vec<String>, (f64, f64))> = Vec::new();
+        // (steps, residual, tolerance, joints) of the Gauss–Seidel warnings
+        let mut gs: Vec<(u64, f64, f64, Vec<String>)> = Vec::new();
         for (pk, j) in jw.peaks.iter().zip(&sim.problem.joints) {
             let node_steps = pk.slave_nodes.max(1) as f64 * steps;
             let lost = pk.events.lost as f64 / node_steps;
@@ -323,10 +324,10 @@ impl Recorder {
             if pk.unconverged_steps > 0 && pk.gs_tolerance > 0.0 && pk.max_gs_residual > GS_WARN_FACTOR * pk.gs_tolerance {
                 // the joints' pairs are swept together, so joints sharing the sweeps report the
                 // same numbers: one warning for them all (a dam's 28 joints gave 28 equal lines)
-                let key = (pk.unconverged_steps, pk.max_gs_residual.to_bits(), pk.gs_tolerance.to_bits());
-                match gs.iter_mut().find(|(k, _, _)| *k == key) {
-                    Some((_, names, _)) => names.push(pk.name.clone()),
-                    None => gs.push((key, vec![pk.name.clone()], (pk.max_gs_residual, pk.gs_tolerance))),
+                let (steps, residual, tolerance) = (pk.unconverged_steps, pk.max_gs_residual, pk.gs_tolerance);
+                match gs.iter_mut().find(|g| (g.0, g.1, g.2) == (steps, residual, tolerance)) {
+                    Some(g) => g.3.push(pk.name.clone()),
+                    None => gs.push((steps, residual, tolerance, vec![pk.name.clone()])),
                 }
             }
             if matches!(j.method, Method::Ntn) && pk.ntn_max_distance > NTN_WARN_FRACTION * pk.face_size {
@@ -336,7 +337,7 @@ impl Recorder {
                 ));
             }
         }
-        for ((steps, _, _), names, (residual, tolerance)) in gs {
+        for (steps, residual, tolerance, names) in gs {
             let who = if names.len() == 1 { format!("joint {}", names[0]) } else { format!("joints {} ({} joints, swept together)", names.join(", "), names.len()) };
             w.push(format!(
                 "{who}: Gauss–Seidel stopped at gs_max_sweeps in {steps} steps with a residual up to {residual:.2e} m, {:.0} × its tolerance {tolerance:.1e} m (above {GS_WARN_FACTOR}×): the contact forces of those steps are not converged (cap: ContactSolver::gs_max_sweeps, 200 sweeps)",
