@@ -21,6 +21,16 @@ use jointquake::problem::Problem;
 use jointquake::scene::Scene;
 use jointquake::simulation::Simulation;
 
+/// The scene of pipelines/dam_coarse.json (massless rock, tied base, 28 Mohr–Coulomb joints,
+/// reservoir at crest − 5 m) with the committed coarse fixture's mesh, patterns expanded.
+pub fn dam_coarse_scene() -> (Scene, Mesh) {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam_coarse.json");
+    let mut s = Scene::load(&path).unwrap();
+    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
+    jointquake::pipeline::expand_patterns(&mut s, &mesh, &path).unwrap();
+    (s, mesh)
+}
+
 /// A scene from inline JSON (fields as in pipelines/*.json).
 pub fn scene(v: serde_json::Value) -> Scene {
     serde_json::from_value(v).expect("test scene parses")

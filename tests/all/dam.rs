@@ -4,7 +4,7 @@
 //! pattern entry, and the group patterns with their errors. The gmsh test (`…_gmsh`) meshes
 //! the coarse variant from the .geo and compares it with the fixture.
 
-use crate::common::{fixture, scratch};
+use crate::common::{dam_coarse_scene, fixture, scratch};
 use jointquake::interface::{tag_joint, JointSpec};
 use jointquake::mesh::pattern::PatternError;
 use jointquake::mesh::{CellKind, Mesh};
@@ -451,13 +451,9 @@ fn tied_two_block_cantilever_modes_match_the_monolithic_one() {
 
 // ---- static state: the construction sequence (issue 15 §2) ---------------------------------
 
-/// The dam scene of pipelines/dam_coarse.json (massless rock, tied base, 28 Mohr–Coulomb
-/// joints, reservoir at crest − 5 m) on the committed coarse fixture, patterns expanded.
+/// The dam of pipelines/dam_coarse.json on the committed coarse fixture (`dam_coarse_scene`).
 fn dam_static_problem() -> jointquake::problem::Problem {
-    let path = repo("pipelines/dam_coarse.json");
-    let mut s = Scene::load(&path).unwrap();
-    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
-    jointquake::pipeline::expand_patterns(&mut s, &mesh, &path).unwrap();
+    let (s, mesh) = dam_coarse_scene();
     jointquake::problem::Problem::build(s, mesh).unwrap()
 }
 
@@ -671,10 +667,7 @@ fn dam_stays_at_rest_for_two_seconds_with_a_full_reservoir() {
 /// (measured 0.74 mm: the joints are planar, so only the chords of the faces differ).
 #[test]
 fn dam_ntn_joints_are_grouted_on_their_master_node() {
-    let path = repo("pipelines/dam_coarse.json");
-    let mut s = Scene::load(&path).unwrap();
-    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
-    jointquake::pipeline::expand_patterns(&mut s, &mesh, &path).unwrap();
+    let (mut s, mesh) = dam_coarse_scene();
     let nts_pb = jointquake::problem::Problem::build(s.clone(), mesh.clone()).unwrap();
     for j in s.joints.iter_mut().filter(|j| j.tied != Some(true)) {
         j.method = Some(jointquake::scene::ContactMethod::Ntn);
@@ -704,7 +697,7 @@ fn dam_ntn_joints_are_grouted_on_their_master_node() {
 /// both tied to the rock by the base, fought the ties (two slightly different constraints on
 /// the same nodes): released at rest, the NTN dam grew a motion ×1.8 a step until the energy
 /// check stopped it at step 70. Such pairs are now not formed (the rule of
-/// `contact::joint::unformed_slave_nodes`). Reference and tolerances as the NTS test (measured:
+/// `contact::joint::unformed_pairs`). Reference and tolerances as the NTS test (measured:
 /// energy balance 5e-15 over 0.3 s).
 #[test]
 fn dam_ntn_static_state_stays_at_rest() {
@@ -717,7 +710,7 @@ fn dam_ntn_static_state_stays_at_rest() {
 /// near 0); with them the Gauss–Seidel sweeps crawled: the dam study's 1× NTS run (coarse mesh,
 /// its own scene: pipelines/dam_study_base.json) averaged 84 sweeps a step and hit the
 /// 200-sweep cap in 23 steps of its first second. Rule: a slave of a tied joint is the slave of
-/// no other joint (`contact::joint::unformed_slave_nodes`). Measured without those pairs over 1 s:
+/// no other joint (`contact::joint::unformed_pairs`). Measured without those pairs over 1 s:
 /// 4.5 sweeps a step, at most 8, none capped. Tolerances: no step at the cap, at most 20 sweeps
 /// in a step, a mean below 10 (the crawl was 84 on average from the first step on).
 #[test]
@@ -755,7 +748,7 @@ fn dam_gauss_seidel_converges_without_the_pairs_on_tied_nodes() {
 /// run: 200 sweeps, the cap, from the first step, 172 a step on average) until the energy check
 /// stopped the run at 5.49 s (coarse) and 3.81 s (default mesh). Rule: a node that is the slave
 /// of several tied joints keeps the tie of the last of them in scene order, the base
-/// (`contact::joint::unformed_slave_nodes`); measured: at most 9 sweeps a step over 6 s at 3×,
+/// (`contact::joint::unformed_pairs`); measured: at most 9 sweeps a step over 6 s at 3×,
 /// energy balance 2e-13. Tolerances: no step at the cap, at most 20 sweeps a step, and the
 /// released-at-rest checks of `dam_released_at_rest`.
 #[test]
@@ -778,10 +771,7 @@ fn monolithic_dam_ties_each_base_node_once() {
 /// base's are 1e-13 m, its two sides coincide).
 #[test]
 fn dam_ties_keep_their_meshed_gap_when_released() {
-    let path = repo("pipelines/dam_coarse.json");
-    let mut s = Scene::load(&path).unwrap();
-    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
-    jointquake::pipeline::expand_patterns(&mut s, &mesh, &path).unwrap();
+    let (mut s, mesh) = dam_coarse_scene();
     for j in s.joints.iter_mut() {
         j.tied = Some(true);
     }

@@ -809,10 +809,7 @@ fn gauss_seidel_warning_is_one_line_for_joints_swept_together() {
     use jointquake::problem::Problem;
     use jointquake::simulation::Simulation;
     let dir = scratch("outputs/gs_cap_dam");
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam_coarse.json");
-    let mut sc = jointquake::scene::Scene::load(&path).unwrap();
-    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
-    jointquake::pipeline::expand_patterns(&mut sc, &mesh, &path).unwrap();
+    let (mut sc, mesh) = crate::common::dam_coarse_scene();
     sc.loads.base.clear();
     let problem = Problem::build(sc, mesh).unwrap();
     let mut sim = Simulation::new(&problem).unwrap();
