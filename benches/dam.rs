@@ -26,12 +26,12 @@
 //! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint).
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
 
-use jointquake::foundation::CondensationMethod;
+use jointquake::problem::foundation::CondensationMethod;
 use jointquake::mesh::Mesh;
 use jointquake::problem::Problem;
 use jointquake::scene::Scene;
 use jointquake::simulation::Simulation;
-use jointquake::scene_patterns::mesh_group_names;
+use jointquake::scene::patterns::mesh_group_names;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;

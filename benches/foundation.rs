@@ -16,7 +16,7 @@
 //!
 //! Run: `cargo bench --bench foundation` (part of `make bench`). `JQ_BENCH_SIZES`: comma list of
 //! `1e4`, `1e5` (default both).
-use jointquake::foundation::{choose_method, Condensation, CondensationMethod};
+use jointquake::problem::foundation::{choose_method, Condensation, CondensationMethod};
 use jointquake::mesh::structured::{box_mesh, BoxSpec};
 use jointquake::mesh::Group;
 use jointquake::model::Model;

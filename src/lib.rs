@@ -37,31 +37,24 @@
 //! drive too. Module dependencies point down (no import loop): `docs/architecture.md`.
 
 pub mod constraint;
-pub mod construction;
 pub mod contact;
-pub mod dam_static;
 pub mod dynamics;
 pub mod error;
-pub mod foundation;
 pub mod gmsh;
 pub mod interface;
 pub mod linalg;
 pub mod mesh;
-pub mod bonded;
-pub mod modes;
 pub mod model;
 pub mod motion;
 pub mod output;
 pub mod pipeline;
 pub mod problem;
 pub mod report;
-pub mod reservoir;
 pub mod rigid;
 pub mod scene;
 pub mod simulation;
-pub mod static_contact;
+pub mod statics;
 pub mod studies;
-pub mod scene_patterns;
 pub mod study;
 pub mod testcase;
 pub mod vtk;

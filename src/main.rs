@@ -541,7 +541,7 @@ fn real_main() -> Result<()> {
             jointquake::pipeline::expand_patterns(&mut s, &mesh, &scene)?;
             let out_dir = out.unwrap_or_else(|| s.output_dir());
             let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
-            let r = jointquake::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;
+            let r = jointquake::statics::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;
             if json {
                 say!("{}", serde_json::to_string_pretty(&r).context("serialising the modes")?);
             } else {
@@ -552,7 +552,7 @@ fn real_main() -> Result<()> {
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
             let mut table_md = None;
             let mut inspect = |sim: &jointquake::simulation::Simulation<'_>, dir: &std::path::Path| -> Result<(), jointquake::Error> {
-                let t = jointquake::dam_static::static_table(&sim.problem.model, &sim.state.u)?;
+                let t = jointquake::studies::dam::static_table::static_table(&sim.problem.model, &sim.state.u)?;
                 std::fs::create_dir_all(dir).map_err(|e| jointquake::error::OutputError::write(dir, e))?;
                 let md = dir.join("static_table.md");
                 std::fs::write(&md, t.to_markdown()).map_err(|e| jointquake::error::OutputError::write(&md, e))?;

@@ -44,12 +44,12 @@ pub fn load_mesh(scene: &Scene, opts: &RunOptions) -> Result<Mesh, Error> {
     Ok(Mesh::from_msh(path)?)
 }
 
-/// Expand the scene's group patterns against the mesh ([`crate::scene_patterns`]) and check
+/// Expand the scene's group patterns against the mesh ([`crate::scene::patterns`]) and check
 /// the expanded scene again (names and joint pairs); errors name the scene file. Must run right
 /// after the mesh is read, before any group lookup.
-pub fn expand_patterns(scene: &mut Scene, mesh: &Mesh, scene_path: &Path) -> Result<Vec<crate::scene_patterns::PatternUse>, Error> {
+pub fn expand_patterns(scene: &mut Scene, mesh: &Mesh, scene_path: &Path) -> Result<Vec<crate::scene::patterns::PatternUse>, Error> {
     let invalid = |message: String| -> Error { crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message }.into() };
-    let uses = scene.expand_group_patterns(&crate::scene_patterns::mesh_group_names(mesh)).map_err(|e| invalid(e.to_string()))?;
+    let uses = scene.expand_group_patterns(&crate::scene::patterns::mesh_group_names(mesh)).map_err(|e| invalid(e.to_string()))?;
     if !uses.is_empty() {
         scene.validate().map_err(invalid)?;
     }
@@ -82,7 +82,7 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
-        crate::construction::equilibrate(&mut sim)?;
+        crate::statics::sequence::equilibrate(&mut sim)?;
         laps.lap("equilibrium");
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
         inspect(&sim, &out_dir)?;

@@ -77,7 +77,7 @@ pub struct Simulation<'p> {
     pub contact: Option<ContactSolver<'p>>,
     /// The static condensation of the massless blocks (`None` without them); runs after the
     /// contact correction (solve per step) or in the element loop (Schur complement).
-    pub foundation: Option<crate::foundation::Condensation>,
+    pub foundation: Option<crate::problem::foundation::Condensation>,
     pub state: State,
     /// The outcome of [`Self::equilibrate`] (`None` before it, or without gravity relaxation).
     pub equilibrium: Option<EquilibriumInfo>,
@@ -93,12 +93,12 @@ impl<'p> Simulation<'p> {
 
     /// [`Simulation::new`] with the massless foundation's condensation method given (`None`:
     /// the rule of `foundation::choose_method`); for tests and benchmarks that compare them.
-    pub fn with_condensation(problem: &'p Problem, method: Option<crate::foundation::CondensationMethod>) -> Result<Simulation<'p>, Error> {
+    pub fn with_condensation(problem: &'p Problem, method: Option<crate::problem::foundation::CondensationMethod>) -> Result<Simulation<'p>, Error> {
         let model = &problem.model;
         let contact = (!problem.joints.is_empty()).then(|| ContactSolver::new(model, &problem.joints));
         let penalty = contact.as_ref().map(|c| c.penalty_omega2_bound(model)).unwrap_or(0.0);
         let t0 = std::time::Instant::now();
-        let foundation = crate::foundation::Condensation::build(model, faer::Par::Seq, method).map_err(|e| ModelError::Invalid(e.to_string()))?;
+        let foundation = crate::problem::foundation::Condensation::build(model, faer::Par::Seq, method).map_err(|e| ModelError::Invalid(e.to_string()))?;
         let mut notes = problem.notes.clone();
         notes.extend(model.mass_scaling.as_ref().map(|m| m.note()));
         // the condensed foundation stiffens the interface: its ω² bound adds to the elements'
@@ -106,8 +106,8 @@ impl<'p> Simulation<'p> {
         if let Some(f) = foundation.as_ref() {
             let i = f.info(t0.elapsed().as_secs_f64());
             let how = match i.method {
-                crate::foundation::CondensationMethod::Solve => "a solve per step".to_string(),
-                crate::foundation::CondensationMethod::Schur => format!("dense Schur complement on the interface, {:.1} MB", i.schur_bytes as f64 / 1e6),
+                crate::problem::foundation::CondensationMethod::Solve => "a solve per step".to_string(),
+                crate::problem::foundation::CondensationMethod::Schur => format!("dense Schur complement on the interface, {:.1} MB", i.schur_bytes as f64 / 1e6),
             };
             notes.push(format!(
                 "massless blocks: {} unknowns condensed on {} interface unknowns ({how}; factor {} entries; setup {:.2} s); foundation ω² bound {:.4e} 1/s² in the stable step",

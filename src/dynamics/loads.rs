@@ -192,18 +192,8 @@ impl Loads {
             notes.push(format!("nodal force at ({:?}) snapped to node {} at distance {:.3e} m", nf.point, model.mesh.node_tags[node], dist));
             patterns.push(ForcePattern { forces: vec![(node, nf.force)], ramp: nf.ramp });
         }
-        let mut static_forces = Vec::new();
-        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic) {
-            let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
-            let mut faces = Vec::new();
-            for g in &r.faces {
-                faces.extend(crate::reservoir::wet_faces(&model.mesh, g, &volume)?);
-            }
-            let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
-            static_forces = crate::reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
-            let total: f64 = static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
-            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), static_forces.len(), total));
-        }
+        // The reservoir's hydrostatic forces are added by problem::Problem::from_model.
+        let static_forces = Vec::new();
         Ok((Loads { gravity, gravity_nodes, base, patterns, static_forces }, notes))
     }
 

@@ -867,11 +867,3 @@ impl Model {
         &self.materials[m as usize].lame
     }
 }
-
-/// The reservoir of a scene on its wet faces: ρw, pool level, bottom (default: the lowest wet
-/// node), g (the scene's gravity, else its standard g).
-pub fn reservoir_spec(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[crate::reservoir::WetFace], scene: &Scene) -> crate::reservoir::ReservoirSpec {
-    let lowest = faces.iter().flat_map(|f| f.nodes.iter()).map(|&v| mesh.nodes[v][2]).fold(f64::INFINITY, f64::min);
-    let g = scene.loads.gravity.as_ref().map(|g| g.g).unwrap_or(scene.g);
-    crate::reservoir::ReservoirSpec { rho_w: r.rho_w, level: r.level, bottom: r.bottom.unwrap_or(lowest), g, local_depth: r.added_mass_depth == "local" }
-}

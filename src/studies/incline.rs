@@ -17,7 +17,7 @@ use crate::error::{Error, OutputError, StudyError};
 use crate::report::{fmt_percent, fmt_sig, Chart, Series, Table};
 use crate::rigid::newmark::{slide_block, Direction, Incline, NewmarkOptions};
 use crate::scene::Scene;
-use crate::study::rigid_level::sample_ground_motion;
+use crate::studies::wedge::rigid_level::sample_ground_motion;
 use crate::study::{kind_params, KindReport, RunResult, Study, StudyKind, StudyResults};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

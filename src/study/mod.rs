@@ -7,7 +7,7 @@
 //! particular study: a study kind ([`StudyKind`], registered in the top-level `studies` module) adds only
 //! its metrics, tables and charts, and any steps of its own (the wedge's strength reduction).
 //! Two procedures studies call live here too: FEM strength reduction ([`ssr`]) and the
-//! rigid-block level of a wedge ([`rigid_level`]). [`slurm`] runs a plan's runs as a Slurm job
+//! rigid-block level of a wedge (`studies::wedge::rigid_level`). [`slurm`] runs a plan's runs as a Slurm job
 //! array instead of `make` (`study submit --slurm`).
 //!
 //! Inputs: a study file (`docs/studies.md`). Outputs under the study's `out`:
@@ -20,7 +20,6 @@
 pub mod file;
 pub mod plan;
 pub mod results;
-pub mod rigid_level;
 pub mod slurm;
 pub mod ssr;
 

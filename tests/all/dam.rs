@@ -9,7 +9,7 @@ use jointquake::interface::{tag_joint, JointSpec};
 use jointquake::mesh::pattern::PatternError;
 use jointquake::mesh::{CellKind, Mesh};
 use jointquake::scene::Scene;
-use jointquake::scene_patterns::mesh_group_names;
+use jointquake::scene::patterns::mesh_group_names;
 use std::path::PathBuf;
 
 /// Parameters of the coarse fixture (scripts/fixtures.sh) and the .geo defaults it keeps.
@@ -421,10 +421,10 @@ fn cantilever_of(div: [usize; 3], split: Option<([usize; 3], [usize; 3])>, tied:
 #[test]
 fn tied_two_block_cantilever_modes_match_the_monolithic_one() {
     let dir = scratch("dam_modes_two_block");
-    let mono = jointquake::modes::modes(&cantilever(None, true), 6, &dir.join("mono")).unwrap();
-    let coarse = jointquake::modes::modes(&cantilever_of([14, 3, 3], None, true), 6, &dir.join("coarse")).unwrap();
-    let conf = jointquake::modes::modes(&cantilever(Some(([10, 4, 4], [10, 4, 4])), true), 6, &dir.join("conf")).unwrap();
-    let nonc = jointquake::modes::modes(&cantilever(Some(([10, 4, 4], [7, 3, 3])), false), 6, &dir.join("nonc")).unwrap();
+    let mono = jointquake::statics::modes::modes(&cantilever(None, true), 6, &dir.join("mono")).unwrap();
+    let coarse = jointquake::statics::modes::modes(&cantilever_of([14, 3, 3], None, true), 6, &dir.join("coarse")).unwrap();
+    let conf = jointquake::statics::modes::modes(&cantilever(Some(([10, 4, 4], [10, 4, 4])), true), 6, &dir.join("conf")).unwrap();
+    let nonc = jointquake::statics::modes::modes(&cantilever(Some(([10, 4, 4], [7, 3, 3])), false), 6, &dir.join("nonc")).unwrap();
     println!("{}{}{}", mono.to_text(), conf.to_text(), nonc.to_text());
     assert_eq!(conf.ties.tied, 25);
     assert_eq!(conf.dofs, mono.dofs);
@@ -442,7 +442,7 @@ fn tied_two_block_cantilever_modes_match_the_monolithic_one() {
     // equal frequencies (square section: any rotation of a pair is a pair of modes)
     for r in [0..2, 2..4, 4..5, 5..6] {
         for c in 0..3 {
-            let sum = |m: &jointquake::modes::ModesReport| m.modes[r.clone()].iter().map(|x| x.effective_fraction[c]).sum::<f64>();
+            let sum = |m: &jointquake::statics::modes::ModesReport| m.modes[r.clone()].iter().map(|x| x.effective_fraction[c]).sum::<f64>();
             assert!((sum(&conf) - sum(&mono)).abs() < 1e-8, "modes {r:?}, direction {c}");
         }
     }
@@ -469,7 +469,7 @@ fn dam_self_weight_with_ungrouted_joints_puts_each_monolith_weight_on_its_base()
     use jointquake::linalg::stiffness_of;
     let pb = dam_static_problem();
     let model = &pb.model;
-    let (u, stage) = jointquake::construction::self_weight_open_joints(&pb).unwrap();
+    let (u, stage) = jointquake::statics::sequence::self_weight_open_joints(&pb).unwrap();
     println!("{stage:?}");
     assert!(stage.residual < 1e-9, "{}", stage.residual);
     let mut f = vec![0.0; u.len()];
@@ -477,7 +477,7 @@ fn dam_self_weight_with_ungrouted_joints_puts_each_monolith_weight_on_its_base()
     grav.static_forces.clear();
     grav.external_force_into(model, 0.0, true, false, &mut f);
     let all: Vec<&jointquake::contact::joint::ContactJoint> = pb.joints.iter().collect();
-    let (ub, _, _) = jointquake::construction::linear_static(&pb, &all, &f).unwrap();
+    let (ub, _, _) = jointquake::statics::sequence::linear_static(&pb, &all, &f).unwrap();
     let base: std::collections::HashSet<usize> = model.mesh.group_nodes("interface:dam:base").unwrap().into_iter().collect();
     let (mut worst, mut worst_bonded) = (0.0f64, 0.0f64);
     for k in 0..=N_JOINTS {
@@ -579,8 +579,8 @@ fn dam_first_modes_empty_and_full_with_joints_bonded() {
     let mut sc = full.scene.clone();
     sc.reservoir = None;
     let empty = jointquake::problem::Problem::build(sc, Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap()).unwrap();
-    let rf = jointquake::modes::modes(&full, 2, &dir.join("full")).unwrap();
-    let re = jointquake::modes::modes(&empty, 2, &dir.join("empty")).unwrap();
+    let rf = jointquake::statics::modes::modes(&full, 2, &dir.join("full")).unwrap();
+    let re = jointquake::statics::modes::modes(&empty, 2, &dir.join("empty")).unwrap();
     println!("{}{}", re.to_text(), rf.to_text());
     assert_eq!(rf.ties.joints, 29);
     assert_eq!(rf.ties.nearest_node, 0);
@@ -606,7 +606,7 @@ fn dam_first_modes_empty_and_full_with_joints_bonded() {
 fn dam_reservoir_stage_with_active_joints_converges_and_its_penalty_error_is_small() {
     let pb = dam_static_problem();
     let model = &pb.model;
-    let (u, _) = jointquake::construction::self_weight_open_joints(&pb).unwrap();
+    let (u, _) = jointquake::statics::sequence::self_weight_open_joints(&pb).unwrap();
     let mut f = vec![0.0; u.len()];
     for &(n, fv) in &pb.loads.static_forces {
         for c in 0..3 {
@@ -617,15 +617,15 @@ fn dam_reservoir_stage_with_active_joints_converges_and_its_penalty_error_is_sma
     let crest_max = |du: &[f64]| crest.iter().map(|&n| (0..3).map(|c| du[3 * n + c] * du[3 * n + c]).sum::<f64>().sqrt()).fold(0.0, f64::max);
     let solve = |factor: f64| {
         let mut contact = jointquake::contact::ContactState::new(&pb.joints);
-        jointquake::construction::grout(&pb, &mut contact, &u).unwrap();
-        jointquake::static_contact::solve_static_increment(&pb, &f, &mut contact, factor).unwrap()
+        jointquake::statics::sequence::grout(&pb, &mut contact, &u).unwrap();
+        jointquake::statics::contact::solve_static_increment(&pb, &f, &mut contact, factor).unwrap()
     };
-    let (du, info) = solve(jointquake::static_contact::PENALTY_FACTOR);
+    let (du, info) = solve(jointquake::statics::contact::PENALTY_FACTOR);
     println!("{}", info.line());
     assert!(info.converged && info.residual < 1e-8, "{}", info.line());
     assert!(info.stick > 0 && info.slip > 0 && info.open > 0, "{}", info.line());
     assert!(info.max_penetration < 1e-3 * info.max_displacement, "{}", info.line());
-    let (du10, info10) = solve(10.0 * jointquake::static_contact::PENALTY_FACTOR);
+    let (du10, info10) = solve(10.0 * jointquake::statics::contact::PENALTY_FACTOR);
     assert!(info10.converged, "{}", info10.line());
     let (a, b) = (crest_max(&du), crest_max(&du10));
     println!("crest's largest displacement: penalty ×1 {a:.6e} m, ×10 {b:.6e} m, change {:.2e}", (a / b - 1.0).abs());
@@ -673,11 +673,11 @@ fn dam_ntn_joints_are_grouted_on_their_master_node() {
         j.method = Some(jointquake::scene::ContactMethod::Ntn);
     }
     let pb = jointquake::problem::Problem::build(s, mesh).unwrap();
-    let (u, _) = jointquake::construction::self_weight_open_joints(&pb).unwrap();
+    let (u, _) = jointquake::statics::sequence::self_weight_open_joints(&pb).unwrap();
     let mut contact = jointquake::contact::ContactState::new(&pb.joints);
-    jointquake::construction::grout(&pb, &mut contact, &u).unwrap();
+    jointquake::statics::sequence::grout(&pb, &mut contact, &u).unwrap();
     let mut nts_contact = jointquake::contact::ContactState::new(&nts_pb.joints);
-    jointquake::construction::grout(&nts_pb, &mut nts_contact, &u).unwrap();
+    jointquake::statics::sequence::grout(&nts_pb, &mut nts_contact, &u).unwrap();
     let x = |n: usize| nalgebra::Vector3::from_fn(|c, _| pb.model.mesh.nodes[n][c] + u[3 * n + c]);
     let (mut worst, mut differ) = (0.0f64, 0.0f64);
     for (ji, j) in pb.joints.iter().enumerate().filter(|(_, j)| !j.law.tied) {
@@ -777,9 +777,9 @@ fn dam_ties_keep_their_meshed_gap_when_released() {
     }
     let pb = jointquake::problem::Problem::build(s, mesh).unwrap();
     let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
-    jointquake::construction::equilibrate(&mut sim).unwrap();
+    jointquake::statics::sequence::equilibrate(&mut sim).unwrap();
     let mut check = jointquake::contact::ContactState::new(&pb.joints);
-    jointquake::construction::grout_pairs(&pb, &mut check, &sim.state.u, |_, _| true).unwrap();
+    jointquake::statics::sequence::grout_pairs(&pb, &mut check, &sim.state.u, |_, _| true).unwrap();
     let (mut worst, mut largest) = (0.0f64, 0.0f64);
     for (ji, j) in pb.joints.iter().enumerate() {
         assert!(j.law.tied);

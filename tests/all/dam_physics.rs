@@ -5,7 +5,7 @@ use crate::common::{problem, scene, scratch};
 use jointquake::linalg::{dof_map, lowest_modes, mass_matrix, restrict, stiffness, ModesOptions, NONE};
 use jointquake::mesh::structured::{box_mesh, BoxSpec};
 use jointquake::mesh::{Group, Mesh};
-use jointquake::foundation::CondensationMethod;
+use jointquake::problem::foundation::CondensationMethod;
 use jointquake::simulation::{FnObserver, Simulation};
 
 /// Both condensation methods (docs/dam_physics.md): every massless-foundation test runs on each.
@@ -246,7 +246,7 @@ fn modes_command_on_the_cantilever_fixture() {
     }));
     let mesh = Mesh::from_msh(crate::common::fixture("cantilever_hex.msh")).unwrap();
     let pb = problem(mesh, &sc, 0.9);
-    let r = jointquake::modes::modes(&pb, 4, &dir).unwrap();
+    let r = jointquake::statics::modes::modes(&pb, 4, &dir).unwrap();
     let text = r.to_text();
     println!("{text}");
     let w1 = 1.875104f64.powi(2) * (1e9f64 / 12.0 / (2000.0 * 1e4)).sqrt();

@@ -19,6 +19,7 @@
 //! normal of the upstream crest arch y = x² / (2 Rc) at the monitor, (−x/Rc, 1, 0) normalised.
 
 pub mod report;
+pub mod static_table;
 
 use crate::error::{Error, OutputError, StudyError};
 use crate::mesh::pattern::{GroupPattern, natural_cmp};

@@ -27,6 +27,7 @@
 //! at the end of gravity equilibrium.
 
 pub mod report;
+pub mod rigid_level;
 
 use crate::error::{Error, ModelError, StudyError};
 use crate::rigid::wedge::{analyse_wedge, HeightDef, WedgeInput};
@@ -230,7 +231,7 @@ impl WedgeKind {
     /// The limit-equilibrium / rigid-block wedge of `scene`: the study's `wedge` geometry with
     /// the strength of the scene's joints on planes A and B and the density of the wedge group.
     pub fn wedge_of(&self, scene: &Scene) -> WedgeInput {
-        crate::study::rigid_level::wedge_input_from_scene(&self.params.wedge, scene, &self.params.joints.a, &self.params.joints.b, &self.params.wedge_group)
+        crate::studies::wedge::rigid_level::wedge_input_from_scene(&self.params.wedge, scene, &self.params.joints.a, &self.params.joints.b, &self.params.wedge_group)
     }
 
     /// The study's PGAs [g] with their labels, in axis order.

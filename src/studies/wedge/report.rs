@@ -21,7 +21,7 @@ use crate::output::history::HistoryTable;
 use crate::report::{fmt_percent, fmt_sig, pareto_front, Axis, Chart, Series, Table};
 use crate::rigid::wedge::{analyse_wedge, build_wedge, HeightDef, WedgeInput};
 use crate::scene::Scene;
-use crate::study::rigid_level::{rigid_wedge_slip, sample_ground_motion, Bond, RigidWedgeRun};
+use crate::studies::wedge::rigid_level::{rigid_wedge_slip, sample_ground_motion, Bond, RigidWedgeRun};
 use crate::study::{scene_for, KindReport, RunCharts, RunResult, StudyResults, Variation};
 use serde::Serialize;
 use std::fmt::Write as _;

@@ -8,6 +8,9 @@
 //! Where the dam's stages go: the reservoir's added mass is added to `model` here
 //! (`Model::add_inertia`), the massless foundation becomes one more constraint of the run.
 
+pub mod foundation;
+pub mod reservoir;
+
 use crate::contact::joint::{build_joints, ContactJoint};
 use crate::dynamics::loads::Loads;
 use crate::error::{Error, ModelError};
@@ -43,21 +46,22 @@ impl Problem {
     /// The joints and loads of `scene` on a built model.
     pub fn from_model(scene: Scene, model: Model) -> Result<Problem, Error> {
         let joints = build_joints(&model.mesh, &scene)?;
-        let (loads, notes) = Loads::build(&model, &scene)?;
+        let (mut loads, mut notes) = Loads::build(&model, &scene)?;
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic) {
+            let (faces, spec) = reservoir::wet_faces_of_scene(&model.mesh, &scene, r)?;
+            loads.static_forces = reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
+            let total: f64 = loads.static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
+            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), loads.static_forces.len(), total));
+        }
         Ok(Problem { scene, model, joints, loads, notes })
     }
 }
 
-/// Add the reservoir's Westergaard/Kuo added mass m_a n nᵀ (`crate::reservoir`) to the inertia
+/// Add the reservoir's Westergaard/Kuo added mass m_a n nᵀ (`crate::problem::reservoir`) to the inertia
 /// of the wet nodes (no weight); a note with the total.
 pub fn add_reservoir_mass(model: &mut Model, scene: &Scene, r: &crate::scene::ReservoirScene) -> Result<String, Error> {
-    let volume: Vec<usize> = scene.materials.iter().map(|m| model.mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
-    let mut faces = Vec::new();
-    for g in &r.faces {
-        faces.extend(crate::reservoir::wet_faces(&model.mesh, g, &volume)?);
-    }
-    let spec = crate::model::reservoir_spec(&model.mesh, r, &faces, scene);
-    let added = crate::reservoir::added_masses(&model.mesh, &faces, &spec);
+    let (faces, spec) = reservoir::wet_faces_of_scene(&model.mesh, scene, r)?;
+    let added = reservoir::added_masses(&model.mesh, &faces, &spec);
     let mut total = 0.0;
     for a in &added {
         if model.mass.inertial[a.node] == 0.0 {

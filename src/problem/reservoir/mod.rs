@@ -258,6 +258,26 @@ fn lower_boundary_nodes(faces: &[WetFace], mesh: &Mesh, level: f64) -> Vec<usize
     nodes
 }
 
+/// The reservoir of a scene on its wet faces: ρw, pool level, bottom (default: the lowest wet
+/// node), g (the scene's gravity, else its standard g).
+pub fn reservoir_spec(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[WetFace], scene: &crate::scene::Scene) -> ReservoirSpec {
+    let lowest = faces.iter().flat_map(|f| f.nodes.iter()).map(|&v| mesh.nodes[v][2]).fold(f64::INFINITY, f64::min);
+    let g = scene.loads.gravity.as_ref().map(|g| g.g).unwrap_or(scene.g);
+    ReservoirSpec { rho_w: r.rho_w, level: r.level, bottom: r.bottom.unwrap_or(lowest), g, local_depth: r.added_mass_depth == "local" }
+}
+
+/// The wet faces of a scene's reservoir (`reservoir.faces`, outward from the scene's volumes)
+/// and its [`ReservoirSpec`]: the one gathering used by the hydrostatic load and the added mass.
+pub fn wet_faces_of_scene(mesh: &Mesh, scene: &crate::scene::Scene, r: &crate::scene::ReservoirScene) -> Result<(Vec<WetFace>, ReservoirSpec), crate::error::Error> {
+    let volume: Vec<usize> = scene.materials.iter().map(|m| mesh.group_of_dim(&m.group, 3).map(|g| g.cells.clone())).collect::<Result<Vec<_>, _>>()?.concat();
+    let mut faces = Vec::new();
+    for g in &r.faces {
+        faces.extend(wet_faces(mesh, g, &volume)?);
+    }
+    let spec = reservoir_spec(mesh, r, &faces, scene);
+    Ok((faces, spec))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

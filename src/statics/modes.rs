@@ -16,7 +16,7 @@
 //! linear reference of dam practice. The shapes are written on every node (u = T φ̂).
 
 use crate::error::{Error, ModelError};
-use crate::bonded::{Bonding, TieInfo};
+use crate::statics::bonding::{Bonding, TieInfo};
 use crate::linalg::{dof_map, lowest_modes, mass_matrix, stiffness, ModesOptions};
 use crate::problem::Problem;
 use crate::vtk::pvd::PvdSeries;

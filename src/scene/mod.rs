@@ -4,6 +4,8 @@
 //! errors (`deny_unknown_fields`). Relative paths inside a scene are relative to the scene
 //! file's directory. Units: SI (m, kg, s, Pa, N); record amplitudes are in g.
 
+pub mod patterns;
+
 use crate::error::SceneError;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -42,7 +44,7 @@ pub struct Scene {
     pub reservoir: Option<ReservoirScene>,
 }
 
-/// The reservoir of a dam (incompressible water; `crate::reservoir`).
+/// The reservoir of a dam (incompressible water; module problem::reservoir).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReservoirScene {

@@ -26,7 +26,7 @@
 //!
 //! Each stage's residual and method are in the returned [`SequenceReport`] and the run's notes.
 
-use crate::bonded::Bonding;
+use crate::statics::bonding::Bonding;
 use crate::contact::joint::ContactJoint;
 use crate::contact::query::select_projection;
 use crate::contact::ContactState;
@@ -35,7 +35,7 @@ use crate::error::{Error, ModelError};
 use crate::linalg::{stiffness, SparseCholesky};
 use crate::problem::Problem;
 use crate::simulation::Simulation;
-use crate::static_contact::solve_static_increment;
+use crate::statics::contact::solve_static_increment;
 use nalgebra::Vector3;
 
 /// One stage of the sequence.
@@ -177,7 +177,7 @@ pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
                     f_static[3 * n + c] += fv[c];
                 }
             }
-            let (du, info) = solve_static_increment(p, &f_static, &mut sim.state.contact, crate::static_contact::PENALTY_FACTOR)?;
+            let (du, info) = solve_static_increment(p, &f_static, &mut sim.state.contact, crate::statics::contact::PENALTY_FACTOR)?;
             if !info.converged {
                 return Err(ModelError::Invalid(format!(
                     "static sequence, stage c (static forces with the joints active): not converged ({}). The joints' contact states cycle: check the joints' friction and the load",

@@ -36,7 +36,7 @@
 //! below [`TOLERANCE`]); the report adds the largest penetration, the pairs in each state and
 //! the pairs held closed ([`CHATTER_CHANGES`]).
 
-use crate::bonded::{master_point, Bonding, MasterHit};
+use crate::statics::bonding::{master_point, Bonding, MasterHit};
 use crate::contact::joint::{ContactJoint, Method};
 use crate::contact::law::{PairHistory, PairState};
 use crate::contact::ContactState;
