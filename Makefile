@@ -59,6 +59,7 @@ demo: venv build
 	@echo "The arch dam study (28 joints at 1x, 2x, 3x the design PGA, NTS against NTN; out/dam/report.md): make dam"
 
 test: venv
+	python3 $$(if [ -f ../shared/tools/modcycles.py ]; then echo ../shared/tools/modcycles.py; else echo scripts/modcycles.py; fi) src
 	JQ_REQUIRE_VENV=1 cargo test --release
 	@echo "== gmsh path: mesh a .geo through the CLI and run it"
 	cargo build --release

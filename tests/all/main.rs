@@ -2,6 +2,7 @@
 //! validation, studies, bad input, regressions named after the bug they pin).
 //! Physics tests state their reference and tolerance in a comment.
 
+mod architecture;
 mod bad_input;
 mod cli;
 mod cluster;
