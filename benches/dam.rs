@@ -31,7 +31,6 @@ use jointquake::mesh::Mesh;
 use jointquake::problem::Problem;
 use jointquake::scene::Scene;
 use jointquake::simulation::Simulation;
-use jointquake::scene::patterns::mesh_group_names;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -108,7 +107,7 @@ fn main() {
                 };
                 let mesh = mesh.clone();
                 let mut sc = scene(rock != "massive");
-                sc.expand_group_patterns(&mesh_group_names(&mesh)).expect("patterns expand on the dam mesh");
+                jointquake::pipeline::expand_patterns(&mut sc, &mesh, std::path::Path::new("benches/dam.rs")).expect("patterns expand on the dam mesh");
                 let t1 = Instant::now();
                 let problem = Problem::build(sc, mesh).expect("dam model");
                 let t_build = t1.elapsed().as_secs_f64();

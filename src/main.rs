@@ -513,8 +513,7 @@ fn real_main() -> Result<()> {
     match cli.cmd {
         Cmd::Mesh { scene, cache } => {
             let s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
-            let opts = RunOptions { mesh_cache: Some(cache), ..Default::default() };
-            let mesh = jointquake::pipeline::load_mesh(&s, &opts).with_context(|| format!("meshing scene {}", scene.display()))?;
+            let mesh = jointquake::pipeline::load_mesh(&s, Some(&cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
             say!("{}", mesh.source.display());
             say!("  {} nodes, {} cells", mesh.nodes.len(), mesh.cells.len());
             for g in &mesh.groups {
@@ -536,9 +535,7 @@ fn real_main() -> Result<()> {
         }
         Cmd::Modes { scene, count, out, cache, json } => {
             let mut s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
-            let opts = RunOptions { mesh_cache: Some(cache), ..Default::default() };
-            let mesh = jointquake::pipeline::load_mesh(&s, &opts).with_context(|| format!("meshing scene {}", scene.display()))?;
-            jointquake::pipeline::expand_patterns(&mut s, &mesh, &scene)?;
+            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &scene, Some(&cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
             let out_dir = out.unwrap_or_else(|| s.output_dir());
             let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
             let r = jointquake::statics::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;

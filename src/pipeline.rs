@@ -15,12 +15,17 @@ use std::time::Instant;
 pub use crate::output::recorder::snap_monitors;
 pub use crate::output::summary::{Peak, RunSummary};
 
+/// Where gmsh meshes are cached when no cache is given [path]: `build/mesh` under the working
+/// directory (the Makefile's and the CLI's default; `make clean` removes it). Meshes are keyed
+/// by the `.geo` text and its `set` numbers, so a shared cache is never stale.
+pub const DEFAULT_MESH_CACHE: &str = "build/mesh";
+
 /// Options of a run that are not part of the scene.
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
     /// Override the output directory.
     pub out_dir: Option<PathBuf>,
-    /// Where gmsh meshes are cached. Default `build/mesh`.
+    /// Where gmsh meshes are cached. Default [`DEFAULT_MESH_CACHE`].
     pub mesh_cache: Option<PathBuf>,
     /// Show a progress bar (only drawn when stderr is a terminal). Default false.
     pub progress: bool,
@@ -31,22 +36,34 @@ pub struct RunOptions {
     pub threads: Option<usize>,
 }
 
-/// Produce the mesh of a scene (gmsh for a `.geo`, or the given `.msh`) and read it.
-pub fn load_mesh(scene: &Scene, opts: &RunOptions) -> Result<Mesh, Error> {
+/// Produce the mesh of a scene (gmsh for a `.geo`, cached under `mesh_cache`, default
+/// [`DEFAULT_MESH_CACHE`]; or the given `.msh`) and read it, as it is: the scene's group
+/// patterns are not expanded (`jointquake mesh` lists the groups; every caller that builds a
+/// problem uses [`load_scene_mesh`]).
+pub fn load_mesh(scene: &Scene, mesh_cache: Option<&Path>) -> Result<Mesh, Error> {
     let path = match (&scene.geometry.geo, &scene.geometry.msh) {
-        (Some(geo), _) => {
-            let cache = opts.mesh_cache.clone().unwrap_or_else(|| PathBuf::from("build/mesh"));
-            crate::gmsh::mesh_geo(geo, &scene.geometry.set, &cache)?
-        }
+        (Some(geo), _) => crate::gmsh::mesh_geo(geo, &scene.geometry.set, mesh_cache.unwrap_or(Path::new(DEFAULT_MESH_CACHE)))?,
         (None, Some(msh)) => msh.clone(),
-        (None, None) => unreachable!("validated"),
+        (None, None) => return Err(crate::error::SceneError::Invalid { path: PathBuf::from(scene.name()), message: "geometry: give `geo` (a Gmsh script) or `msh` (a mesh file)".into() }.into()),
     };
     Ok(Mesh::from_msh(path)?)
 }
 
+/// The mesh of a scene and the scene made ready for it, the one way every caller loads a
+/// scene's mesh (the run, `tag`, `modes`, the wedge's strength reduction, the tests): the mesh
+/// as [`load_mesh`] makes it, then the scene's group patterns expanded against it and the
+/// expanded scene checked again ([`expand_patterns`]). Errors name `scene_path` (the scene's
+/// file, or for a scene built in memory the file it came from).
+pub fn load_scene_mesh(scene: &mut Scene, scene_path: &Path, mesh_cache: Option<&Path>) -> Result<Mesh, Error> {
+    let mesh = load_mesh(scene, mesh_cache)?;
+    expand_patterns(scene, &mesh, scene_path)?;
+    Ok(mesh)
+}
+
 /// Expand the scene's group patterns against the mesh ([`crate::scene::patterns`]) and check
-/// the expanded scene again (names and joint pairs); errors name the scene file. Must run right
-/// after the mesh is read, before any group lookup.
+/// the expanded scene again (names and joint pairs); errors name the scene file. The second
+/// half of [`load_scene_mesh`], for a caller that has the mesh already (a benchmark that reuses
+/// one mesh for several scenes). Must run right after the mesh is read, before any group lookup.
 pub fn expand_patterns(scene: &mut Scene, mesh: &Mesh, scene_path: &Path) -> Result<Vec<crate::scene::patterns::PatternUse>, Error> {
     let invalid = |message: String| -> Error { crate::error::SceneError::Invalid { path: scene_path.to_path_buf(), message }.into() };
     let uses = scene.expand_group_patterns(&crate::scene::patterns::mesh_group_names(mesh)).map_err(|e| invalid(e.to_string()))?;
@@ -73,8 +90,7 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
         }
         scene.time.duration = d;
     }
-    let mesh = load_mesh(&scene, opts)?;
-    expand_patterns(&mut scene, &mesh, scene_path)?;
+    let mesh = load_scene_mesh(&mut scene, scene_path, opts.mesh_cache.as_deref())?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");
     let problem = Problem::build(scene, mesh)?;
@@ -82,7 +98,7 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
-        crate::statics::sequence::equilibrate(&mut sim)?;
+        sim.equilibrate()?;
         laps.lap("equilibrium");
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
         inspect(&sim, &out_dir)?;
@@ -135,10 +151,7 @@ pub fn default_threads(elements: usize, available: usize) -> usize {
 // ---------------------------------------------------------------------------------------------
 // `jointquake tag`: tag the joints of a scene and write them for inspection (no time stepping).
 
-/// Default joint tolerance as a fraction of the mesh bounding-box diagonal, used when a joint
-/// gives no `tolerance`. 1e-6: far above the round-off of coordinates written by Gmsh (≈1e-16
-/// relative) and far below any gap a real model would want closed silently.
-pub const DEFAULT_JOINT_TOLERANCE_RELATIVE: f64 = 1e-6;
+pub use crate::contact::joint::DEFAULT_JOINT_TOLERANCE_RELATIVE;
 
 /// What `tag` found for one joint (lengths in m, areas in m²).
 #[derive(Clone, Debug, Serialize)]
@@ -208,8 +221,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
     }
     // Joint names (non-empty, distinct file stems) are checked by `Scene::validate`, again after
     // the patterns are expanded.
-    let mesh = load_mesh(&scene, opts)?;
-    expand_patterns(&mut scene, &mesh, scene_path)?;
+    let mesh = load_scene_mesh(&mut scene, scene_path, opts.mesh_cache.as_deref())?;
     let model_size = mesh.diagonal();
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| scene.output_dir());
     let dir = out_dir.join("tagging");
@@ -221,10 +233,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
     let stems: Vec<String> = scene.joints.iter().map(|j| crate::scene::joint_file_stem(&j.name)).collect();
     for (j, stem) in scene.joints.iter().zip(&stems) {
         let spec = JointSpec { name: j.name.clone(), master: j.master.clone(), slave: j.slave.clone(), auto: j.auto };
-        let (tolerance, source) = match j.tolerance {
-            Some(t) => (t, "scene"),
-            None => (DEFAULT_JOINT_TOLERANCE_RELATIVE * model_size, "default"),
-        };
+        let (tolerance, source) = crate::contact::joint::joint_tolerance(j.tolerance, model_size);
         let joint = tag_joint_in(&mesh, &blocks, &spec, tolerance)?;
         let vtu = dir.join(format!("{stem}.vtu"));
         write_joint_vtu(&vtu, &mesh, &joint)?;
@@ -288,7 +297,7 @@ impl TagSummary {
             let _ = writeln!(s, "  slave           \"{}\": {} nodes, {} faces, {:.4} m²", j.slave_group, j.slave_nodes, j.slave_faces, j.slave_area);
             let _ = writeln!(s, "  master          \"{}\": {} nodes, {} faces, {:.4} m²", j.master_group, j.master_nodes, j.master_faces, j.master_area);
             let _ = writeln!(s, "  roles           {choice}");
-            let _ = writeln!(s, "  tolerance       {:.3e} m ({})", j.tolerance, if j.tolerance_source == "scene" { "from the scene" } else { "default: 1e-6 × model size" });
+            let _ = writeln!(s, "  tolerance       {:.3e} m ({})", j.tolerance, if j.tolerance_source == "scene" { "from the scene".to_string() } else { format!("default: {DEFAULT_JOINT_TOLERANCE_RELATIVE:e} × model size") });
             let _ = writeln!(s, "  candidates      Layer1 {:.2}, Layer2 {:.2} master faces per slave node (mean)", j.layer1_mean, j.layer2_mean);
             let _ = writeln!(
                 s,

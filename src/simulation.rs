@@ -12,9 +12,12 @@
 //! Sequence and invariants:
 //! - `new`: dt resolved (scene `time.dt` checked against the stable step, penalty bound
 //!   included), state at rest at t = 0, energy account started.
-//! - `equilibrate`: the scene's `equilibrium` (relaxation of gravity with the joints' bonds kept
-//!   or not, residual checked against `max_residual`), then the clock restarts at t = 0 and
-//!   the joints' slip counters restart (slip while settling is not seismic slip).
+//! - `equilibrate`: the one door to the static state: the scene's `equilibrium` (its
+//!   `sequence`: the construction sequence's direct solves in `statics::sequence`, or the
+//!   relaxation of gravity with the joints' bonds kept or not, residual checked against
+//!   `max_residual`), then the reset written once ([`Simulation::restart_after_static`]): the
+//!   clock restarts at t = 0 and the joints' slip counters restart (slip while settling is not
+//!   seismic slip).
 //! - `run`: `duration / dt` = N dynamic steps and one look-ahead step: after step k the
 //!   observer sees u[k−1], u[k], u[k+1] and reports at t[k] ([`Simulation::kinematics`]), so the
 //!   outputs reach t[N] = duration with central-difference velocity and acceleration; the state
@@ -27,6 +30,7 @@ use crate::dynamics::time::TimeStep;
 use crate::dynamics::{relax_gravity, EquilibriumInfo, ExplicitSolver, Kinematics, Stage, State, StepInfo};
 use crate::error::{Error, ModelError, StepError};
 use crate::problem::Problem;
+use crate::statics::sequence::{SequenceReport, StageReport};
 
 /// What watches a run: called once before the first dynamic step, after every step and at the
 /// end.
@@ -79,7 +83,7 @@ pub struct Simulation<'p> {
     /// contact correction (solve per step) or in the element loop (Schur complement).
     pub foundation: Option<crate::problem::foundation::Condensation>,
     pub state: State,
-    /// The outcome of [`Self::equilibrate`] (`None` before it, or without gravity relaxation).
+    /// The outcome of [`Self::equilibrate`] (`None` before it, or without a static state).
     pub equilibrium: Option<EquilibriumInfo>,
     /// Notes for the summary (the problem's, then the run's).
     pub notes: Vec<String>,
@@ -132,14 +136,53 @@ impl<'p> Simulation<'p> {
         self.time.steps_for(self.problem.scene.time.duration)
     }
 
-    /// Gravity equilibrium as the scene's `equilibrium` says (nothing without gravity or with
-    /// `method: "none"`), then the clock and the joints' slip counters restart. An equilibrium
-    /// not reached within `max_residual` is an error; one above `tolerance` only a note.
-    pub fn equilibrate(&mut self) -> Result<Option<&EquilibriumInfo>, Error> {
-        let sc = &self.problem.scene;
-        if (self.problem.loads.gravity.is_none() && self.problem.loads.static_forces.is_empty()) || sc.equilibrium.method != "relaxation" {
-            return Ok(None);
+    /// The static state as the scene's `equilibrium` says: the one door to it (the CLI's run,
+    /// `dam-static`, the generated joint tests and the tests all come through here).
+    ///
+    /// - `sequence: "construction"` (with gravity or static forces and `method: "relaxation"`):
+    ///   the construction sequence's direct solves ([`crate::statics::sequence::construction_into`]:
+    ///   self-weight on ungrouted joints, grouting, the static forces with the joints active).
+    /// - otherwise (`"simultaneous"`, `"grouted"`): the tied joints (and, `"grouted"`, every
+    ///   joint) grouted on the initial configuration, then the relaxation of gravity and the
+    ///   static forces with the joints' bonds kept or not ([`Self::relax`]); an equilibrium not
+    ///   reached within `max_residual` is an error, one above `tolerance` only a note. Nothing
+    ///   without gravity and static forces, or with `method: "none"`.
+    ///
+    /// Then [`Self::restart_after_static`] (when a static state was computed). The stages go to
+    /// the notes and the returned report; the outcome is kept in [`Self::equilibrium`].
+    pub fn equilibrate(&mut self) -> Result<SequenceReport, Error> {
+        let p = self.problem;
+        let sc = &p.scene;
+        let sequence = sc.equilibrium.sequence.clone();
+        let loaded = p.loads.gravity.is_some() || !p.loads.static_forces.is_empty();
+        let relaxing = loaded && sc.equilibrium.method == "relaxation";
+        let mut stages = Vec::new();
+        if sequence == "construction" && relaxing {
+            let mut u = vec![0.0; self.state.u.len()];
+            let (st, residual) = crate::statics::sequence::construction_into(p, &mut self.state.contact, &mut u)?;
+            stages.extend(st);
+            self.state.u.copy_from_slice(&u);
+            self.state.u_prev.copy_from_slice(&u);
+            self.equilibrium = Some(EquilibriumInfo { steps: 0, residual, converged: true });
+            self.restart_after_static();
+        } else {
+            stages.extend(crate::statics::sequence::grout_before_relaxation(p, &mut self.state.contact, sequence == "grouted")?);
+            if relaxing {
+                let eq = self.relax_checked()?;
+                stages.push(StageReport { name: "all loads, joints in contact".into(), method: "relaxation".into(), residual: eq.residual, steps: eq.steps, note: String::new() });
+                self.equilibrium = Some(eq);
+                self.restart_after_static();
+            }
         }
+        let report = SequenceReport { sequence, stages };
+        self.notes.extend(report.lines());
+        Ok(report)
+    }
+
+    /// The relaxation of the scene's `equilibrium` (tolerance, max_steps, joint_bonds), checked
+    /// against `max_residual` (error) and `tolerance` (a note).
+    fn relax_checked(&mut self) -> Result<EquilibriumInfo, Error> {
+        let sc = &self.problem.scene;
         if let Some(c) = self.contact.as_mut() {
             c.keep_bonds = sc.equilibrium.joint_bonds == "kept";
         }
@@ -157,10 +200,15 @@ impl<'p> Simulation<'p> {
         if let Some(c) = self.contact.as_mut() {
             c.keep_bonds = false;
         }
+        Ok(eq)
+    }
+
+    /// The reset after the static state, written once: the clock restarts at t = 0 from the
+    /// current state (taken as at rest), with the energy account from it, and the joints' slip
+    /// counters restart (slip while settling is not seismic slip).
+    pub fn restart_after_static(&mut self) {
         self.restart_clock();
         self.state.contact.restart_slip();
-        self.equilibrium = Some(eq);
-        Ok(self.equilibrium.as_ref())
     }
 
     /// Dynamic relaxation of gravity alone ([`relax_gravity`]) with the joints in contact, to a

@@ -87,7 +87,7 @@ impl ContactJoint {
         if !(edge_tolerance > 0.0 && edge_tolerance < 0.5) {
             return Err(bad(format!("edge_tolerance = {edge_tolerance} must be in (0, 0.5) (fraction of the face size)")));
         }
-        let tol = spec.tolerance.unwrap_or(1e-6 * model_size);
+        let (tol, _) = joint_tolerance(spec.tolerance, model_size);
         let js = JointSpec { name: spec.name.clone(), master: spec.master.clone(), slave: spec.slave.clone(), auto: spec.auto };
         let tag = tag_joint_in(mesh, blocks, &js, tol)?;
         // a pair "opens" (and loses its bond) only beyond the round-off of its gap
@@ -139,9 +139,25 @@ pub fn unformed_pairs(joints: &[ContactJoint]) -> Vec<Vec<bool>> {
     joints.iter().enumerate().map(|(ji, j)| j.tag.slave_nodes().iter().map(|s| last_tie.get(s).is_some_and(|&t| t != ji)).collect()).collect()
 }
 
+/// Default joint tolerance as a fraction of the mesh bounding-box diagonal, used when a joint
+/// gives no `tolerance`. 1e-6: far above the round-off of coordinates written by Gmsh (≈1e-16
+/// relative) and far below any gap a real model would want closed silently.
+pub const DEFAULT_JOINT_TOLERANCE_RELATIVE: f64 = 1e-6;
+
+/// The tagging tolerance of a joint [m], the one rule (the run's joints and `jointquake tag`):
+/// the joint's `tolerance` when the scene gives it, else [`DEFAULT_JOINT_TOLERANCE_RELATIVE`] ×
+/// `model_size` (the mesh's bounding-box diagonal [m]); with where it came from, "scene" or
+/// "default".
+pub fn joint_tolerance(tolerance: Option<f64>, model_size: f64) -> (f64, &'static str) {
+    match tolerance {
+        Some(t) => (t, "scene"),
+        None => (DEFAULT_JOINT_TOLERANCE_RELATIVE * model_size, "default"),
+    }
+}
+
 /// The joints stage: tag every joint of the scene on the mesh (once, on the initial
-/// configuration) and resolve its law and options, in scene order. The default tagging
-/// tolerance is 1e-6 × the mesh's bounding-box diagonal.
+/// configuration) and resolve its law and options, in scene order. The tagging tolerance:
+/// [`joint_tolerance`].
 pub fn build_joints(mesh: &Mesh, scene: &Scene) -> Result<Vec<ContactJoint>, Error> {
     let size = mesh.diagonal();
     if scene.joints.is_empty() {

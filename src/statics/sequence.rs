@@ -25,16 +25,19 @@
 //! 10).
 //!
 //! Each stage's residual and method are in the returned [`SequenceReport`] and the run's notes.
+//!
+//! The door: this module has no entry of its own. `simulation::Simulation::equilibrate` (the one
+//! door to the static state, written there as plain text because simulation sits above statics)
+//! calls [`construction_into`] or [`grout_before_relaxation`] and the relaxation, sets its state
+//! and resets the clock and the slip counters once.
 
 use crate::statics::bonding::Bonding;
 use crate::contact::joint::ContactJoint;
 use crate::contact::query::select_projection;
 use crate::contact::ContactState;
-use crate::dynamics::EquilibriumInfo;
 use crate::error::{Error, ModelError};
 use crate::linalg::{stiffness, SparseCholesky};
 use crate::problem::Problem;
-use crate::simulation::Simulation;
 use crate::statics::contact::solve_static_increment;
 use nalgebra::Vector3;
 
@@ -152,90 +155,77 @@ pub fn grout_pairs(problem: &Problem, contact: &mut ContactState, u: &[f64], whi
     Ok(StageReport { name: "b: grouting".into(), method: "grouting".into(), residual: 0.0, steps: 0, note })
 }
 
-/// The static state of `sim` as its scene's `equilibrium.sequence` says, then the clock and
-/// the slip counters restart (as `Simulation::equilibrate`). The stage lines go to the notes.
-pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
-    let p = sim.problem;
-    let sc = &p.scene;
-    let sequence = sc.equilibrium.sequence.clone();
+/// The construction sequence's stages (a) self-weight with the joints ungrouted, (b) grouting,
+/// (c) the static forces with the joints active, from rest: the static displacement is written
+/// into `u` and the contact history (gap offsets, pair states and forces) into `contact`.
+/// Returns the stages' reports and stage (c)'s relative residual. Called only by the one door,
+/// `simulation::Simulation::equilibrate`, which sets its state from `u` and resets the clock.
+pub fn construction_into(p: &Problem, contact: &mut ContactState, u: &mut [f64]) -> Result<(Vec<StageReport>, f64), Error> {
     let mut stages = Vec::new();
-    let relaxing = sc.equilibrium.method == "relaxation" && (p.loads.gravity.is_some() || !p.loads.static_forces.is_empty());
-    match sequence.as_str() {
-        "construction" if relaxing => {
-            let (u, a) = self_weight_open_joints(p)?;
-            sim.state.u.copy_from_slice(&u);
-            sim.state.u_prev.copy_from_slice(&u);
-            stages.push(a);
-            stages.push(grout(p, &mut sim.state.contact, &u)?);
-            // (c) the static forces with the joints active: an active-set direct solve
-            // (`static_contact`). Dynamic relaxation, started from the linear response with
-            // every joint bonded, had not converged on the arch dam (residual 2.2e-2 after
-            // 40 000 steps; 5.4e-2 ramped in from rest).
-            let mut f_static = vec![0.0; u.len()];
-            for &(n, fv) in &p.loads.static_forces {
-                for c in 0..3 {
-                    f_static[3 * n + c] += fv[c];
-                }
-            }
-            let (du, info) = solve_static_increment(p, &f_static, &mut sim.state.contact, crate::statics::contact::PENALTY_FACTOR)?;
-            if !info.converged {
-                return Err(ModelError::Invalid(format!(
-                    "static sequence, stage c (static forces with the joints active): not converged ({}). The joints' contact states cycle: check the joints' friction and the load",
-                    info.line()
-                ))
-                .into());
-            }
-            for (x, d) in sim.state.u.iter_mut().zip(&du) {
-                *x += d;
-            }
-            sim.state.u_prev.copy_from_slice(&sim.state.u);
-            // the closed pairs carry the penalty's small penetration (info.max_penetration);
-            // the explicit run's contact is exact and would push it out in one step, so they
-            // are re-grouted where they are: the dynamic stage starts with them touching.
-            // The tied joints too: the static solves tie each slave to its master point with
-            // the gap it was meshed with (`bonded`: u_s = Σ N_I u_I), while an explicit tie
-            // holds the gap offset, 0 until grouted, and would close the meshed gap (the
-            // chords of non-conforming tied joints) in the first step (regression
-            // `dam_ties_keep_their_meshed_gap_when_released`).
-            let closed: Vec<Vec<bool>> = sim.state.contact.joints.iter().enumerate().map(|(ji, j)| j.pairs.iter().map(|r| p.joints[ji].law.tied || r.state != crate::contact::law::PairState::Open).collect()).collect();
-            grout_pairs(p, &mut sim.state.contact, &sim.state.u, |ji, i| closed[ji][i])?;
-            // (grouting sets only the offsets: the pairs keep their forces and states; a
-            // closed pair's gap is 0 from here)
-            for (ji, j) in sim.state.contact.joints.iter_mut().enumerate() {
-                for (i, r) in j.pairs.iter_mut().enumerate() {
-                    if closed[ji][i] {
-                        r.gap = 0.0;
-                    }
-                }
-            }
-            stages.push(StageReport {
-                name: "c: static forces (reservoir), joints active".into(),
-                method: "Newton, direct solves (penalty contact)".into(),
-                residual: info.residual,
-                steps: 0,
-                note: info.line(),
-            });
-            let eq = EquilibriumInfo { steps: 0, residual: info.residual, converged: true };
-            sim.restart_clock();
-            sim.state.contact.restart_slip();
-            sim.equilibrium = Some(EquilibriumInfo { steps: eq.steps, residual: eq.residual, converged: eq.converged });
+    let (u_a, a) = self_weight_open_joints(p)?;
+    u.copy_from_slice(&u_a);
+    stages.push(a);
+    stages.push(grout(p, contact, u)?);
+    // (c) the static forces with the joints active: an active-set direct solve
+    // (`static_contact`). Dynamic relaxation, started from the linear response with
+    // every joint bonded, had not converged on the arch dam (residual 2.2e-2 after
+    // 40 000 steps; 5.4e-2 ramped in from rest).
+    let mut f_static = vec![0.0; u.len()];
+    for &(n, fv) in &p.loads.static_forces {
+        for c in 0..3 {
+            f_static[3 * n + c] += fv[c];
         }
-        _ => {
-            let zero = vec![0.0; sim.state.u.len()];
-            if sequence == "grouted" {
-                stages.push(grout(p, &mut sim.state.contact, &zero)?);
-            }
-            // a tie holds the gap it was meshed with, as in the static solves (`bonded`) and
-            // in the construction sequence above
-            if p.joints.iter().any(|j| j.law.tied) {
-                grout_pairs(p, &mut sim.state.contact, &zero, |ji, _| p.joints[ji].law.tied)?;
-            }
-            if let Some(eq) = sim.equilibrate()? {
-                stages.push(StageReport { name: "all loads, joints in contact".into(), method: "relaxation".into(), residual: eq.residual, steps: eq.steps, note: String::new() });
+    }
+    let (du, info) = solve_static_increment(p, &f_static, contact, crate::statics::contact::PENALTY_FACTOR)?;
+    if !info.converged {
+        return Err(ModelError::Invalid(format!(
+            "static sequence, stage c (static forces with the joints active): not converged ({}). The joints' contact states cycle: check the joints' friction and the load",
+            info.line()
+        ))
+        .into());
+    }
+    for (x, d) in u.iter_mut().zip(&du) {
+        *x += d;
+    }
+    // the closed pairs carry the penalty's small penetration (info.max_penetration);
+    // the explicit run's contact is exact and would push it out in one step, so they
+    // are re-grouted where they are: the dynamic stage starts with them touching.
+    // The tied joints too: the static solves tie each slave to its master point with
+    // the gap it was meshed with (`bonded`: u_s = Σ N_I u_I), while an explicit tie
+    // holds the gap offset, 0 until grouted, and would close the meshed gap (the
+    // chords of non-conforming tied joints) in the first step (regression
+    // `dam_ties_keep_their_meshed_gap_when_released`).
+    let closed: Vec<Vec<bool>> = contact.joints.iter().enumerate().map(|(ji, j)| j.pairs.iter().map(|r| p.joints[ji].law.tied || r.state != crate::contact::law::PairState::Open).collect()).collect();
+    grout_pairs(p, contact, u, |ji, i| closed[ji][i])?;
+    // (grouting sets only the offsets: the pairs keep their forces and states; a
+    // closed pair's gap is 0 from here)
+    for (ji, j) in contact.joints.iter_mut().enumerate() {
+        for (i, r) in j.pairs.iter_mut().enumerate() {
+            if closed[ji][i] {
+                r.gap = 0.0;
             }
         }
     }
-    let report = SequenceReport { sequence, stages };
-    sim.notes.extend(report.lines());
-    Ok(report)
+    stages.push(StageReport {
+        name: "c: static forces (reservoir), joints active".into(),
+        method: "Newton, direct solves (penalty contact)".into(),
+        residual: info.residual,
+        steps: 0,
+        note: info.line(),
+    });
+    Ok((stages, info.residual))
+}
+
+/// Before the relaxation of a `"simultaneous"` or `"grouted"` sequence (from rest): every joint
+/// that is not tied grouted on the initial configuration when `grouted`, and the tied joints
+/// grouted there always (a tie holds the gap it was meshed with, as in the static solves,
+/// `bonding`, and in the construction sequence). Returns the grouting stage's report when
+/// `grouted`.
+pub fn grout_before_relaxation(p: &Problem, contact: &mut ContactState, grouted: bool) -> Result<Option<StageReport>, Error> {
+    let zero = vec![0.0; 3 * p.model.n_nodes()];
+    let stage = if grouted { Some(grout(p, contact, &zero)?) } else { None };
+    if p.joints.iter().any(|j| j.law.tied) {
+        grout_pairs(p, contact, &zero, |ji, _| p.joints[ji].law.tied)?;
+    }
+    Ok(stage)
 }

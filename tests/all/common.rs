@@ -26,8 +26,8 @@ use jointquake::simulation::Simulation;
 pub fn dam_coarse_scene() -> (Scene, Mesh) {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam_coarse.json");
     let mut s = Scene::load(&path).unwrap();
-    let mesh = Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
-    jointquake::pipeline::expand_patterns(&mut s, &mesh, &path).unwrap();
+    // the scene reads the committed fixture (geometry.msh = tests/fixtures/arch_dam_coarse.msh)
+    let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, None).unwrap();
     (s, mesh)
 }
 

@@ -777,7 +777,7 @@ fn dam_ties_keep_their_meshed_gap_when_released() {
     }
     let pb = jointquake::problem::Problem::build(s, mesh).unwrap();
     let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
-    jointquake::statics::sequence::equilibrate(&mut sim).unwrap();
+    sim.equilibrate().unwrap();
     let mut check = jointquake::contact::ContactState::new(&pb.joints);
     jointquake::statics::sequence::grout_pairs(&pb, &mut check, &sim.state.u, |_, _| true).unwrap();
     let (mut worst, mut largest) = (0.0f64, 0.0f64);

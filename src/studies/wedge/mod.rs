@@ -346,8 +346,7 @@ impl WedgeKind {
         };
         let mut scene = scene_for(study, &base, &labels, &[], &format!("ssr-{level}"))?;
         scene.loads.base.clear();
-        let opts = crate::pipeline::RunOptions { mesh_cache: Some(mesh_cache.to_path_buf()), ..Default::default() };
-        let mesh = crate::pipeline::load_mesh(&scene, &opts)?;
+        let mesh = crate::pipeline::load_scene_mesh(&mut scene, &study.scene, Some(mesh_cache))?;
         let p1 = scene.output.monitor.iter().find(|m| m.name == self.params.monitors.p1).map(|m| m.point);
         let ssr_opts = crate::study::ssr::SsrOptions {
             bracket: spec.bracket,
