@@ -7,7 +7,7 @@
 
 use super::record::Record;
 use crate::error::{Error, ModelError};
-use crate::mesh::CellKind;
+use crate::interface::{face_nodal_weights_into, FaceWeights};
 use crate::model::Model;
 use crate::motion::synth::{COMPONENT_NAMES, synthesize_components};
 use crate::motion::{Baseline, Drift, MotionError, SynthRequest, correct, drift};
@@ -46,6 +46,22 @@ pub fn base_motions(scene: &Scene) -> Result<(Vec<BaseMotion>, Vec<String>), Err
     Ok((base, notes))
 }
 
+/// "Scale to a PGA", the one rule: the factor that brings a record whose peak |a| is `peak`
+/// [m/s²] to `pga` [g], pga · g / peak (`g` [m/s²] the scene's); `None` for a record of zeros
+/// (peak 0), which no factor scales. Two callers, two meanings of "the PGA", each named where
+/// it is used:
+/// - a scene's base entry `pga` (**record PGA**, here): each record on its own peak, after its
+///   baseline correction;
+/// - a study's `pga` (**study PGA**, `study::plan`): one factor for every record of the scene,
+///   the one that brings the *first* record to the PGA, so the others keep their ratio to it
+///   (the vertical at 2/3 of the horizontal).
+///
+/// (A synthetic component is generated at its PGA exactly, its peak sample set to ±PGA:
+/// `motion::synth`; the factor here is then 1 up to round-off.)
+pub fn scale_for_pga(peak: f64, pga: f64, g: f64) -> Option<f64> {
+    (peak > 0.0).then(|| pga * g / peak)
+}
+
 /// Entry `k` of `loads.base` as a [`BaseMotion`] and its note.
 fn base_motion(scene: &Scene, k: usize, b: &BaseRecord) -> Result<(BaseMotion, String), Error> {
     let label = b.label(k);
@@ -70,13 +86,7 @@ fn base_motion(scene: &Scene, k: usize, b: &BaseRecord) -> Result<(BaseMotion, S
     }
     let d = Vector3::from(b.direction).normalize();
     let scale = match (b.scale, b.pga) {
-        (_, Some(pga)) => {
-            let peak = record.peak();
-            if peak == 0.0 {
-                return Err(invalid(format!("the record is all zeros: cannot scale it to pga {pga} g")));
-            }
-            pga * scene.g / peak
-        }
+        (_, Some(pga)) => scale_for_pga(record.peak(), pga, scene.g).ok_or_else(|| invalid(format!("the record is all zeros: cannot scale it to pga {pga} g")))?,
         (Some(s), None) => s,
         (None, None) => 1.0,
     };
@@ -177,12 +187,18 @@ impl Loads {
         for t in &scene.loads.traction {
             let g = model.mesh.group_of_dim(&t.group, 2)?;
             let mut forces: Vec<(usize, [f64; 3])> = Vec::new();
+            let mut w = FaceWeights::default();
             for &c in &g.cells {
                 let cell = &model.mesh.cells[c];
-                let x: Vec<Vector3<f64>> = cell.nodes().iter().map(|&n| model.mesh.x(n as usize)).collect();
-                let w = face_node_areas(cell.kind, &x);
-                for (a, &n) in cell.nodes().iter().enumerate() {
-                    forces.push((n as usize, [t.traction[0] * w[a], t.traction[1] * w[a], t.traction[2] * w[a]]));
+                let nodes = &cell.nodes()[..cell.nodes().len().min(4)];
+                let mut x = [[0.0; 3]; 4];
+                for (xa, &n) in x.iter_mut().zip(nodes) {
+                    *xa = model.mesh.nodes[n as usize];
+                }
+                face_nodal_weights_into(cell.kind, &x[..nodes.len()], &mut w);
+                for (a, &n) in nodes.iter().enumerate() {
+                    let wa = w.area[a];
+                    forces.push((n as usize, [t.traction[0] * wa, t.traction[1] * wa, t.traction[2] * wa]));
                 }
             }
             patterns.push(ForcePattern { forces, ramp: t.ramp });
@@ -264,36 +280,5 @@ impl Loads {
                 }
             }
         }
-    }
-}
-
-/// ∫ N_a dA for each node of a tri3 / quad4 face (2×2 Gauss for quads, exact for bilinear).
-pub fn face_node_areas(kind: CellKind, x: &[Vector3<f64>]) -> Vec<f64> {
-    match kind {
-        CellKind::Tri3 => {
-            let a = 0.5 * (x[1] - x[0]).cross(&(x[2] - x[0])).norm();
-            vec![a / 3.0; 3]
-        }
-        CellKind::Quad4 => {
-            let gp = 1.0 / 3f64.sqrt();
-            let r = crate::mesh::cell::QUAD4_REF;
-            let mut w = vec![0.0; 4];
-            for &s in &[-gp, gp] {
-                for &t in &[-gp, gp] {
-                    let mut dxs = Vector3::zeros();
-                    let mut dxt = Vector3::zeros();
-                    for a in 0..4 {
-                        dxs += x[a] * 0.25 * r[a][0] * (1.0 + t * r[a][1]);
-                        dxt += x[a] * 0.25 * r[a][1] * (1.0 + s * r[a][0]);
-                    }
-                    let j = dxs.cross(&dxt).norm();
-                    for a in 0..4 {
-                        w[a] += j * 0.25 * (1.0 + s * r[a][0]) * (1.0 + t * r[a][1]);
-                    }
-                }
-            }
-            w
-        }
-        _ => vec![0.0; x.len()],
     }
 }

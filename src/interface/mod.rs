@@ -33,7 +33,7 @@ pub use candidates::{
     layer1_candidates, layer2_candidates, master_surface_distances_into, nearest_master_nodes_into,
     point_triangle_distance,
 };
-pub use normals::{face_area, face_unit_normal, slave_normals_into, tributary_areas_into, tributary_vectors_into};
+pub use normals::{face_area, face_nodal_weights_into, face_unit_normal, slave_normals_into, tributary_areas_into, tributary_vectors_into, FaceWeights};
 pub use surface::{Face, Surface};
 pub use synthetic::flat_joint_mesh;
 pub use write::{JOINT_JSON_VERSION, write_joint_json, write_joint_vtu};

@@ -8,7 +8,9 @@
 //! - Tributary area of node I: ∫ N_I dA over its faces. Tri3: area/3 per node (exact). Quad4:
 //!   2×2 Gauss on the bilinear map, exact for planar quads (N_I·detJ is then of degree ≤ 2 per
 //!   direction) and a consistent approximation for warped ones. The areas of a surface sum to its
-//!   area as computed by [`face_area`].
+//!   area as computed by [`face_area`]. One kernel computes these nodal weights of a face,
+//!   [`face_nodal_weights_into`], for every caller (the tagger here, the scene's tractions, the
+//!   reservoir's added mass).
 
 use super::{Surface, invalid};
 use crate::error::InterfaceError;
@@ -41,23 +43,62 @@ pub fn face_unit_normal(kind: CellKind, x: &[[f64; 3]]) -> [f64; 3] {
 /// 2×2 Gauss points (±1/√3, weights 1).
 const G: f64 = 0.577_350_269_189_625_8;
 const GAUSS2: [[f64; 2]; 4] = [[-G, -G], [G, -G], [G, G], [-G, G]];
-const QREF: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
+const QREF: [[f64; 2]; 4] = crate::mesh::cell::QUAD4_REF;
 
-/// ∫ N_I dA of each node of a quad4 (2×2 Gauss), into `out`.
-#[inline]
-pub(crate) fn quad_tributary(x: &[[f64; 3]], out: &mut [f64; 4]) {
-    *out = [0.0; 4];
-    for [xi, eta] in GAUSS2 {
-        let mut dxi = Vector3::zeros();
-        let mut deta = Vector3::zeros();
-        for (i, r) in QREF.iter().enumerate() {
-            dxi += vec3(x[i]) * (0.25 * r[0] * (1.0 + eta * r[1]));
-            deta += vec3(x[i]) * (0.25 * r[1] * (1.0 + xi * r[0]));
+/// The nodal weights of one face (see [`face_nodal_weights_into`]); entries past the face's
+/// nodes are 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FaceWeights {
+    /// ∫ N_I dA of each node I [m²] (its tributary area on this face).
+    pub area: [f64; 4],
+    /// ∫ N_I n dA of each node I [m²]: the area-weighted outward normal (n the unit normal of the
+    /// face where it is integrated; equal to the face normal × `area` on a planar face).
+    pub vector: [[f64; 3]; 4],
+}
+
+/// The one face-integration kernel (the tagger's tributary areas, the scene's tractions in
+/// `dynamics::loads`, the reservoir's added mass in `problem::reservoir`): the nodal weights
+/// ∫ N_I dA and ∫ N_I n dA of each node I of a face with points `x` (Gmsh node order, outward;
+/// 3 points of a tri3, 4 of a quad4) into `w`.
+///
+/// - tri3: exact, a third of the area each (N_I integrates to A/3), along the face normal.
+/// - quad4: 2×2 Gauss on the bilinear map, exact for planar quads (N_I · det J has degree ≤ 2
+///   per direction) and a consistent approximation for warped ones; the weights sum to the
+///   face's area as [`face_area`] computes it.
+/// - any other kind (not a face): all 0.
+pub fn face_nodal_weights_into(kind: CellKind, x: &[[f64; 3]], w: &mut FaceWeights) {
+    *w = FaceWeights::default();
+    match kind {
+        CellKind::Quad4 => {
+            for [xi, eta] in GAUSS2 {
+                let mut dxi = Vector3::zeros();
+                let mut deta = Vector3::zeros();
+                for (i, r) in QREF.iter().enumerate() {
+                    dxi += vec3(x[i]) * (0.25 * r[0] * (1.0 + eta * r[1]));
+                    deta += vec3(x[i]) * (0.25 * r[1] * (1.0 + xi * r[0]));
+                }
+                let j = dxi.cross(&deta);
+                let det = j.norm();
+                for (i, r) in QREF.iter().enumerate() {
+                    let n = 0.25 * (1.0 + xi * r[0]) * (1.0 + eta * r[1]);
+                    w.area[i] += n * det;
+                    let v = j * n;
+                    for c in 0..3 {
+                        w.vector[i][c] += v[c];
+                    }
+                }
+            }
         }
-        let det = dxi.cross(&deta).norm();
-        for (i, r) in QREF.iter().enumerate() {
-            out[i] += 0.25 * (1.0 + xi * r[0]) * (1.0 + eta * r[1]) * det;
+        CellKind::Tri3 => {
+            let j = face_normal_raw(kind, x);
+            let third = (0.5 * j.norm()) / 3.0;
+            let v = (j * 0.5) / 3.0;
+            for i in 0..3 {
+                w.area[i] = third;
+                w.vector[i] = [v[0], v[1], v[2]];
+            }
         }
+        CellKind::Tet4 | CellKind::Hex8 => {}
     }
 }
 
@@ -65,9 +106,9 @@ pub(crate) fn quad_tributary(x: &[[f64; 3]], out: &mut [f64; 4]) {
 pub fn face_area(kind: CellKind, x: &[[f64; 3]]) -> f64 {
     match kind {
         CellKind::Quad4 => {
-            let mut t = [0.0; 4];
-            quad_tributary(x, &mut t);
-            t.iter().sum()
+            let mut w = FaceWeights::default();
+            face_nodal_weights_into(kind, x, &mut w);
+            w.area.iter().sum()
         }
         _ => 0.5 * face_normal_raw(kind, x).norm(),
     }
@@ -104,25 +145,16 @@ pub fn slave_normals_into(joint: &str, surface: &Surface, out: &mut [[f64; 3]]) 
     Ok(())
 }
 
-/// ∫ N_I dA of each node of one face with points `x` into `t` (quad4: `quad_tributary`; tri3:
-/// a third of the area each).
-fn face_tributaries_into(kind: CellKind, x: &[[f64; 3]; 4], t: &mut [f64; 4]) {
-    match kind {
-        CellKind::Quad4 => quad_tributary(x, t),
-        _ => *t = [face_area(kind, &x[..3]) / 3.0; 4],
-    }
-}
-
 /// Tributary area [m²] of every node of `surface` (local node order) into `out`.
 pub fn tributary_areas_into(surface: &Surface, out: &mut [f64]) {
     assert_eq!(out.len(), surface.nodes.len());
     out.iter_mut().for_each(|a| *a = 0.0);
-    let mut t = [0.0; 4];
+    let mut w = FaceWeights::default();
     for (f, face) in surface.faces.iter().enumerate() {
         let (x, n) = surface.face_points(f);
-        face_tributaries_into(face.kind, &x, &mut t);
+        face_nodal_weights_into(face.kind, &x[..n], &mut w);
         for (k, &l) in face.local_nodes().iter().enumerate().take(n) {
-            out[l as usize] += t[k];
+            out[l as usize] += w.area[k];
         }
     }
 }
@@ -134,14 +166,14 @@ pub fn tributary_areas_into(surface: &Surface, out: &mut [f64]) {
 pub fn tributary_vectors_into(surface: &Surface, out: &mut [[f64; 3]]) {
     assert_eq!(out.len(), surface.nodes.len());
     out.iter_mut().for_each(|a| *a = [0.0; 3]);
-    let mut t = [0.0; 4];
+    let mut w = FaceWeights::default();
     for (f, face) in surface.faces.iter().enumerate() {
         let (x, n) = surface.face_points(f);
-        face_tributaries_into(face.kind, &x, &mut t);
+        face_nodal_weights_into(face.kind, &x[..n], &mut w);
         let nf = face_unit_normal(face.kind, &x[..n]);
         for (k, &l) in face.local_nodes().iter().enumerate().take(n) {
             for c in 0..3 {
-                out[l as usize][c] += nf[c] * t[k];
+                out[l as usize][c] += nf[c] * w.area[k];
             }
         }
     }
@@ -154,10 +186,11 @@ mod tests {
     /// Reference: 3×3 Gauss-Legendre (exact for degree ≤ 5 per direction) of N_I·|x_ξ × x_η| on a
     /// planar trapezoid, where the integrand has degree ≤ 2 per direction. Tolerance 1e-14 relative.
     #[test]
-    fn quad_tributary_matches_3x3_gauss_on_planar_trapezoid() {
+    fn quad_nodal_weights_match_3x3_gauss_on_planar_trapezoid() {
         let x = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [1.5, 1.0, 0.0], [0.3, 1.2, 0.0]];
-        let mut t = [0.0; 4];
-        quad_tributary(&x, &mut t);
+        let mut w = FaceWeights::default();
+        face_nodal_weights_into(CellKind::Quad4, &x, &mut w);
+        let t = w.area;
         let g3 = [(-(0.6f64).sqrt(), 5.0 / 9.0), (0.0, 8.0 / 9.0), ((0.6f64).sqrt(), 5.0 / 9.0)];
         let mut r = [0.0; 4];
         for &(xi, wx) in &g3 {

@@ -82,11 +82,7 @@ impl InclineKind {
         if j.cohesion.is_some_and(|c| c != 0.0) {
             return Err(format!("joint \"{}\" has cohesion: the Newmark reference here is cohesionless", j.name));
         }
-        Ok(match (j.mu, j.phi) {
-            (Some(mu), _) => mu.atan().to_degrees(),
-            (None, Some(p)) => p,
-            (None, None) => 0.6f64.atan().to_degrees(),
-        })
+        Ok(j.friction().phi_deg())
     }
 
     fn down_slope(&self) -> [f64; 3] {

@@ -27,8 +27,9 @@ pub struct Variation {
     /// jobs end together. Axis values only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cost: Option<f64>,
-    /// Target PGA [g] of the first base record; every record of the scene is scaled by the same
-    /// factor, so the others keep their ratio to it.
+    /// The study PGA [g]: the target PGA of the first base record; every record of the scene is
+    /// scaled by the same factor, so the others keep their ratio to it (unlike a scene entry's
+    /// own `pga`, the record PGA, which scales that record alone: `dynamics::loads::scale_for_pga`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pga: Option<f64>,
     /// Factor on every base record's amplitude [-] (after `pga`).

@@ -183,19 +183,18 @@ fn apply_json(root: &mut Value, v: &Variation) -> Result<(), String> {
     Ok(())
 }
 
-/// Factor that brings the first base record of `scene` to `pga` [g] (all records get it).
+/// The study PGA's factor (`dynamics::loads::scale_for_pga`, the study meaning): the one that
+/// brings the first base record of `scene`, as the scene scales it, to `pga` [g] (all records
+/// get it).
 fn pga_factor(scene: &Scene, pga: f64) -> Result<f64, Error> {
     let (base, _) = base_motions(scene)?;
     let first = base.first().ok_or_else(|| ModelError::Invalid("`pga`: the scene has no `loads.base` record to scale".into()))?;
     let peak = first.record.peak() * first.scale; // m/s²
-    if peak <= 0.0 {
-        return Err(ModelError::Invalid(format!("record {} is all zeros: cannot scale it to {pga} g", first.record.path.display())).into());
-    }
-    Ok(pga * scene.g / peak)
+    crate::dynamics::loads::scale_for_pga(peak, pga, scene.g).ok_or_else(|| ModelError::Invalid(format!("record {} is all zeros: cannot scale it to {pga} g", first.record.path.display())).into())
 }
 
-/// Scale every record so that the first peaks at `pga` [g]; the records' own `pga`/`scale`
-/// become one `scale` each.
+/// The study PGA: scale every record so that the first peaks at `pga` [g]; the records' own
+/// `pga`/`scale` become one `scale` each.
 fn apply_pga(s: &mut Scene, pga: f64) -> Result<(), Error> {
     let f = pga_factor(s, pga)?;
     let (motions, _) = base_motions(s)?;

@@ -205,14 +205,14 @@ impl AddedMass {
 /// dam's bank sections, where the water above the rock is shallower, it is smaller.
 pub fn added_masses(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Vec<AddedMass> {
     let mut acc: std::collections::BTreeMap<usize, (f64, Vector3<f64>)> = Default::default();
+    let mut w = crate::interface::FaceWeights::default();
     for f in faces {
-        let x: Vec<Vector3<f64>> = f.nodes.iter().map(|&n| mesh.x(n)).collect();
-        for (nsh, da) in face_points(f.kind, &x, false) {
-            for (a, &node) in f.nodes.iter().enumerate() {
-                let e = acc.entry(node).or_insert((0.0, Vector3::zeros()));
-                e.0 += nsh[a] * da.norm();
-                e.1 += da * nsh[a];
-            }
+        let x: Vec<[f64; 3]> = f.nodes.iter().map(|&n| mesh.nodes[n]).collect();
+        crate::interface::face_nodal_weights_into(f.kind, &x, &mut w);
+        for (a, &node) in f.nodes.iter().enumerate() {
+            let e = acc.entry(node).or_insert((0.0, Vector3::zeros()));
+            e.0 += w.area[a];
+            e.1 += Vector3::from(w.vector[a]);
         }
     }
     let heel = if spec.local_depth { lower_boundary_nodes(faces, mesh, spec.level) } else { Vec::new() };

@@ -849,11 +849,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         .iter()
         .filter(|j| [&prm.joints.a, &prm.joints.b].contains(&&j.name))
         .map(|j| {
-            let phi = match (j.mu, j.phi) {
-                (Some(mu), _) => mu.atan().to_degrees(),
-                (None, Some(p)) => p,
-                (None, None) => 0.6f64.atan().to_degrees(),
-            };
+            let phi = j.friction().phi_deg();
             format!("{} φ = {}°, c = {} kPa", j.name, fmt_sig_short(phi), fmt_sig_short(j.cohesion.unwrap_or(0.0) / 1e3))
         })
         .collect::<Vec<_>>()
