@@ -317,40 +317,16 @@ impl Schedule {
 }
 
 impl Model {
-    /// Build the model: materials, elements, masses, fixed components, stable-step data.
+    /// Build the model: materials, elements, masses, fixed components, stable-step data. The
+    /// steps, in order: the material of every cell ([`material_owners`]), the nodes of the joint
+    /// faces (the massive layer of a massless block, [`joint_face_nodes`]), the elements and
+    /// their lumped masses in cell order ([`ElementScan`]), the assembly order
+    /// ([`ElementScan::take_sets`]), the supports ([`supports`]), the mass-scaling summary
+    /// ([`mass_scaling_summary`]), the mass-damped nodes ([`mass_damped_nodes`]), then the
+    /// critical element.
     pub fn build(mesh: Mesh, scene: &Scene) -> Result<Model, crate::Error> {
         let n = mesh.nodes.len();
-        let mut materials = Vec::new();
-        // material of every mesh cell (u32::MAX: none)
-        let mut owner = vec![u32::MAX; mesh.cells.len()];
-        for (mi, ms) in scene.materials.iter().enumerate() {
-            // rho = 0 without `massless`: nodes without inertia, held (the scene loader refuses it)
-            let g = mesh.group_of_dim(&ms.group, 3)?;
-            mesh.check_orientation(g)?;
-            for &c in &g.cells {
-                if owner[c] != u32::MAX {
-                    return Err(ModelError::Invalid(format!(
-                        "element {} is in two material groups, \"{}\" and \"{}\"",
-                        mesh.cells[c].tag, scene.materials[owner[c] as usize].group, ms.group
-                    ))
-                    .into());
-                }
-                owner[c] = mi as u32;
-            }
-            materials.push(Material::new(&ms.group, ms.e, ms.nu, ms.rho));
-        }
-
-        // ---- elements, in cell order (the order the masses are summed in)
-        let mut tn = Vec::new();
-        let mut tm = Vec::new();
-        let mut tc = Vec::new();
-        let mut hn = Vec::new();
-        let mut hs = Vec::new();
-        let mut hm = Vec::new();
-        let mut hc = Vec::new();
-        let mut shapes: Vec<HexShape> = Vec::new();
-        let mut shape_key: HashMap<(usize, [i64; 21]), u32> = HashMap::new();
-        let mut mass = vec![0.0; n];
+        let (materials, owner) = material_owners(&mesh, scene)?;
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
         // mass scaling (scene time.mass_scaling): the element ω² above which an element's density
         // is scaled, its factor per mesh cell, and the scaled (inertial) nodal masses; `mass`
@@ -359,222 +335,34 @@ impl Model {
             Some(ms) => Some(mass_scaling::target_omega2(ms.target_dt / scene.time.courant_or_default(), alpha, beta).map_err(ModelError::Invalid)?),
             None => None,
         };
-        let mut mass_scale = if target_w2.is_some() { vec![1.0; mesh.cells.len()] } else { Vec::new() };
-        let mut inertial = if target_w2.is_some() { vec![0.0; n] } else { Vec::new() };
-        // ω² per hex shape, computed once when scaling (NaN: not yet)
-        let mut shape_w2: Vec<f64> = Vec::new();
-        // mass from the elements of massive blocks alone (a node with only layer mass is weightless)
-        let mut massive_mass = vec![0.0; n];
         let massless: Vec<bool> = scene.materials.iter().map(|m| m.massless).collect();
-        // nodes of the joint faces: the elements of a massless block that touch one keep their
-        // mass (the thin massive layer along a joint on a massless block, docs/dam_physics.md)
-        let mut joint_node = vec![false; n];
-        if massless.iter().any(|&m| m) {
-            for js in &scene.joints {
-                for g in [&js.master, &js.slave] {
-                    for node in mesh.group_nodes(g)? {
-                        joint_node[node] = true;
-                    }
-                }
-            }
-        }
-        let mut element_massless_cell = vec![false; mesh.cells.len()];
-        let mut active = vec![false; n];
-        let inverted = |c: usize, mi: usize| -> crate::Error {
-            MeshError::InvertedElement {
-                path: mesh.source.clone(),
-                group: materials[mi].group.clone(),
-                element: mesh.cells[c].tag,
-                jacobian: mesh.min_corner_jacobian(c),
-            }
-            .into()
-        };
-        let tet_x = |nodes: &[u32]| -> [Vector3<f64>; 4] { std::array::from_fn(|a| mesh.x(nodes[a] as usize)) };
+        let joint_node = joint_face_nodes(&mesh, scene, &massless)?;
+        let mut scan = ElementScan::new(n, mesh.cells.len(), target_w2.is_some());
         for (c, &mi) in owner.iter().enumerate() {
-            if mi == u32::MAX {
-                continue;
-            }
-            let mi = mi as usize;
-            let cell = &mesh.cells[c];
-            let layer = massless[mi] && cell.nodes().iter().any(|&v| joint_node[v as usize]);
-            if layer && materials[mi].rho == 0.0 {
-                return Err(ModelError::Invalid(format!(
-                    "material \"{}\" is massless with rho = 0, but element {} touches a joint face: a joint on a massless block needs the density of the block's layer along the joint (give `rho`; docs/dam_physics.md)",
-                    materials[mi].group, cell.tag
-                ))
-                .into());
-            }
-            let rho = if massless[mi] && !layer { 0.0 } else { materials[mi].rho };
-            element_massless_cell[c] = massless[mi] && !layer;
-            match cell.kind {
-                CellKind::Tet4 => {
-                    // geometry recomputed in assembly order below (not stored twice)
-                    let g = tet4::tet_geometry(&tet_x(cell.nodes())).ok_or_else(|| inverted(c, mi))?;
-                    if let Some(t) = target_w2 {
-                        // a pure massless element (rho 0 here) has no step and no inertia
-                        let s = if rho > 0.0 { mass_scaling::factor(tet4::max_eigenvalue(&g.grad, g.vol, rho, &materials[mi].lame), t) } else { 1.0 };
-                        mass_scale[c] = s;
-                        for a in 0..4 {
-                            inertial[cell.node(a)] += s * rho * g.vol / 4.0;
-                        }
-                    }
-                    for a in 0..4 {
-                        mass[cell.node(a)] += rho * g.vol / 4.0;
-                        if !massless[mi] {
-                            massive_mass[cell.node(a)] += rho * g.vol / 4.0;
-                        }
-                        active[cell.node(a)] = true;
-                    }
-                    tn.push(std::array::from_fn(|a| cell.nodes()[a]));
-                    tm.push(mi as u16);
-                    tc.push(c as u32);
-                }
-                CellKind::Hex8 => {
-                    let x: [Vector3<f64>; 8] = std::array::from_fn(|a| mesh.x(cell.node(a)));
-                    // congruence key: edge vectors from node 0, rounded to 1e-9 of the element size
-                    let size = (x[6] - x[0]).norm();
-                    let q = 1e-9 * size;
-                    let mut key = [0i64; 21];
-                    for a in 1..8 {
-                        for i in 0..3 {
-                            key[3 * (a - 1) + i] = ((x[a][i] - x[0][i]) / q).round() as i64;
-                        }
-                    }
-                    let id = match shape_key.get(&(mi, key)) {
-                        Some(&id) => id,
-                        None => {
-                            let s = hex8::hex_shape(&x, &materials[mi].lame).ok_or_else(|| inverted(c, mi))?;
-                            shapes.push(s);
-                            let id = (shapes.len() - 1) as u32;
-                            shape_key.insert((mi, key), id);
-                            id
-                        }
-                    };
-                    let s = &shapes[id as usize];
-                    if let Some(t) = target_w2 {
-                        let f = if rho > 0.0 {
-                            if shape_w2.len() <= id as usize {
-                                shape_w2.resize(id as usize + 1, f64::NAN);
-                            }
-                            if shape_w2[id as usize].is_nan() {
-                                shape_w2[id as usize] = hex8::max_eigenvalue(s, rho, &materials[mi].lame);
-                            }
-                            mass_scaling::factor(shape_w2[id as usize], t)
-                        } else {
-                            1.0
-                        };
-                        mass_scale[c] = f;
-                        for a in 0..8 {
-                            inertial[cell.node(a)] += f * rho * s.vol * s.mass_frac[a];
-                        }
-                    }
-                    for a in 0..8 {
-                        mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
-                        if !massless[mi] {
-                            massive_mass[cell.node(a)] += rho * s.vol * s.mass_frac[a];
-                        }
-                        active[cell.node(a)] = true;
-                    }
-                    hn.push(std::array::from_fn(|a| cell.nodes()[a]));
-                    hs.push(id);
-                    hm.push(mi as u16);
-                    hc.push(c as u32);
-                }
-                _ => unreachable!("material groups hold volume cells only"),
+            if mi != u32::MAX {
+                scan.add_cell(&mesh, &materials, &massless, &joint_node, target_w2, c, mi as usize)?;
             }
         }
         drop(owner);
-        drop(shape_key);
-        if tn.is_empty() && hn.is_empty() {
+        if scan.tn.is_empty() && scan.hn.is_empty() {
             return Err(ModelError::Invalid("the material groups hold no tet4 or hex8 elements".into()).into());
         }
-        let (to, tsched) = assembly_order(&tn, &mesh.nodes)?;
-        let tets = {
-            let nodes = permute(&tn, &to);
-            drop(tn);
-            // the same computation as above on the same coordinates: identical values
-            let geom = nodes.iter().map(|nd| tet4::tet_geometry(&tet_x(nd)).expect("checked above")).collect();
-            Tet4Set { nodes, geom, mat: permute(&tm, &to), cell: permute(&tc, &to), schedule: tsched }
-        };
-        drop((to, tm, tc));
-        let (ho, hsched) = assembly_order(&hn, &mesh.nodes)?;
-        let hexes = Hex8Set {
-            nodes: permute(&hn, &ho),
-            shape: permute(&hs, &ho),
-            mat: permute(&hm, &ho),
-            cell: permute(&hc, &ho),
-            schedule: hsched,
-            shapes,
-        };
-        drop((ho, hn, hs, hm, hc));
-
-        // ---- boundary conditions
-        let mut fixed: Vec<u8> = active.iter().map(|&a| if a { 0 } else { 7 }).collect();
-        // nodes of the massless elements (without mass: condensed)
-        let mut condensed = vec![0u8; n];
-        for (c, &ml) in element_massless_cell.iter().enumerate() {
-            if ml {
-                for &v in mesh.cells[c].nodes() {
-                    if mass[v as usize] == 0.0 {
-                        condensed[v as usize] = 7;
-                    }
-                }
-            }
-        }
-        for b in &scene.boundary {
-            let bits = b.fix.iter().fold(0u8, |acc, c| acc | match c.as_str() { "x" => 1, "y" => 2, _ => 4 });
-            for node in mesh.group_nodes(&b.group)? {
-                fixed[node] |= bits;
-                condensed[node] &= !bits;
-            }
-        }
+        let (tets, hexes) = scan.take_sets(&mesh)?;
+        let ElementScan { mass, mut inertial, mut mass_scale, massive_mass, massless_cell: element_massless_cell, active, .. } = scan;
+        let (fixed, condensed) = supports(&mesh, scene, &active, &mass, &element_massless_cell)?;
         if mass.iter().all(|&m| m == 0.0) {
             return Err(ModelError::Invalid("every material group is massless: nothing carries mass to integrate in time (a massless block supports a massive one)".into()).into());
         }
         let weightless: Vec<bool> = (0..n).map(|i| mass[i] > 0.0 && massive_mass[i] == 0.0).collect();
         drop(massive_mass);
-        let mass_scaling = scene.time.mass_scaling.as_ref().map(|ms| {
-            let (mut count, mut max_factor, mut max_cell) = (0usize, 1.0, None);
-            for (c, &f) in mass_scale.iter().enumerate() {
-                if f > 1.0 {
-                    count += 1;
-                    if f > max_factor {
-                        (max_factor, max_cell) = (f, Some(c));
-                    }
-                }
-            }
-            // added = Σ (s − 1) ρ V: the scaled total minus the unscaled one
-            let total: f64 = mass.iter().sum();
-            let added = if count > 0 { inertial.iter().sum::<f64>() - total } else { 0.0 };
-            MassScaling {
-                target_dt: ms.target_dt,
-                element_dt: ms.target_dt / scene.time.courant_or_default(),
-                scaled_elements: count,
-                added_mass: added,
-                total_mass: total,
-                max_factor,
-                max_factor_element: max_cell.map(|c| mesh.cells[c].tag).unwrap_or(0),
-            }
-        });
+        let mass_scaling = mass_scaling_summary(&mesh, scene, &mass_scale, &mass, &inertial);
         // without a scaled element the inertia is the unscaled mass (and no separate weight)
         let scaled = mass_scaling.as_ref().is_some_and(|m| m.scaled_elements > 0);
         if !scaled {
             inertial = Vec::new();
             mass_scale = Vec::new();
         }
-        let mass_damped = match &scene.damping.mass_groups {
-            None => vec![true; n],
-            Some(groups) => {
-                let mut d = vec![false; n];
-                for g in groups {
-                    mesh.group_of_dim(g, 3)?;
-                    for node in mesh.group_nodes(g)? {
-                        d[node] = true;
-                    }
-                }
-                d
-            }
-        };
+        let mass_damped = mass_damped_nodes(&mesh, scene)?;
         let held = fixed.iter().zip(&mass).map(|(&f, &m)| if m > 0.0 { f } else { 7 }).collect();
         let mut model = Model {
             mesh,
@@ -866,4 +654,309 @@ impl Model {
         let m = if e < nt { self.tets.mat[e] } else { self.hexes.mat[e - nt] };
         &self.materials[m as usize].lame
     }
+}
+
+// ---- the steps of `Model::build`, in its order
+
+/// The materials of the scene, in scene order, and the material of every mesh cell
+/// (`u32::MAX`: none). A cell in two material groups is an error naming both.
+fn material_owners(mesh: &Mesh, scene: &Scene) -> Result<(Vec<Material>, Vec<u32>), crate::Error> {
+    let mut materials = Vec::new();
+    let mut owner = vec![u32::MAX; mesh.cells.len()];
+    for (mi, ms) in scene.materials.iter().enumerate() {
+        // rho = 0 without `massless`: nodes without inertia, held (the scene loader refuses it)
+        let g = mesh.group_of_dim(&ms.group, 3)?;
+        mesh.check_orientation(g)?;
+        for &c in &g.cells {
+            if owner[c] != u32::MAX {
+                return Err(ModelError::Invalid(format!(
+                    "element {} is in two material groups, \"{}\" and \"{}\"",
+                    mesh.cells[c].tag, scene.materials[owner[c] as usize].group, ms.group
+                ))
+                .into());
+            }
+            owner[c] = mi as u32;
+        }
+        materials.push(Material::new(&ms.group, ms.e, ms.nu, ms.rho));
+    }
+    Ok((materials, owner))
+}
+
+/// The nodes of the joint faces when a material is massless (else none): the elements of a
+/// massless block that touch one keep their mass (the thin massive layer along a joint on a
+/// massless block, docs/dam_physics.md).
+fn joint_face_nodes(mesh: &Mesh, scene: &Scene, massless: &[bool]) -> Result<Vec<bool>, crate::Error> {
+    let mut joint_node = vec![false; mesh.nodes.len()];
+    if massless.iter().any(|&m| m) {
+        for js in &scene.joints {
+            for g in [&js.master, &js.slave] {
+                for node in mesh.group_nodes(g)? {
+                    joint_node[node] = true;
+                }
+            }
+        }
+    }
+    Ok(joint_node)
+}
+
+/// The elements of the material groups in cell order (the order the masses are summed in),
+/// before the assembly order, and the nodal masses they lump. Scratch of `Model::build`.
+struct ElementScan {
+    /// tet4: nodes, material, mesh cell.
+    tn: Vec<[u32; 4]>,
+    tm: Vec<u16>,
+    tc: Vec<u32>,
+    /// hex8: nodes, shape id, material, mesh cell.
+    hn: Vec<[u32; 8]>,
+    hs: Vec<u32>,
+    hm: Vec<u16>,
+    hc: Vec<u32>,
+    /// The congruent hex8 shapes, keyed by (material, edge vectors rounded to 1e-9 of the size).
+    shapes: Vec<HexShape>,
+    shape_key: HashMap<(usize, [i64; 21]), u32>,
+    /// ω² per hex shape, computed once when scaling (NaN: not yet).
+    shape_w2: Vec<f64>,
+    /// Lumped nodal mass [kg], unscaled (the weight).
+    mass: Vec<f64>,
+    /// Mass scaling: the scaled (inertial) nodal masses and the factor per mesh cell (empty
+    /// without `time.mass_scaling`).
+    inertial: Vec<f64>,
+    mass_scale: Vec<f64>,
+    /// Mass from the elements of massive blocks alone (a node with only layer mass is weightless).
+    massive_mass: Vec<f64>,
+    /// Mesh cells of massless blocks that are not in the layer along a joint.
+    massless_cell: Vec<bool>,
+    /// Nodes of at least one element.
+    active: Vec<bool>,
+}
+
+impl ElementScan {
+    fn new(nodes: usize, cells: usize, scaling: bool) -> ElementScan {
+        ElementScan {
+            tn: Vec::new(),
+            tm: Vec::new(),
+            tc: Vec::new(),
+            hn: Vec::new(),
+            hs: Vec::new(),
+            hm: Vec::new(),
+            hc: Vec::new(),
+            shapes: Vec::new(),
+            shape_key: HashMap::new(),
+            shape_w2: Vec::new(),
+            mass: vec![0.0; nodes],
+            inertial: if scaling { vec![0.0; nodes] } else { Vec::new() },
+            mass_scale: if scaling { vec![1.0; cells] } else { Vec::new() },
+            massive_mass: vec![0.0; nodes],
+            massless_cell: vec![false; cells],
+            active: vec![false; nodes],
+        }
+    }
+
+    /// Add mesh cell `c` of material `mi`: its density (0 for a massless block's element off
+    /// the joint layer), its lumped mass (scaled to `target_w2` when given), its element.
+    #[allow(clippy::too_many_arguments)]
+    fn add_cell(&mut self, mesh: &Mesh, materials: &[Material], massless: &[bool], joint_node: &[bool], target_w2: Option<f64>, c: usize, mi: usize) -> Result<(), crate::Error> {
+        let cell = &mesh.cells[c];
+        let layer = massless[mi] && cell.nodes().iter().any(|&v| joint_node[v as usize]);
+        if layer && materials[mi].rho == 0.0 {
+            return Err(ModelError::Invalid(format!(
+                "material \"{}\" is massless with rho = 0, but element {} touches a joint face: a joint on a massless block needs the density of the block's layer along the joint (give `rho`; docs/dam_physics.md)",
+                materials[mi].group, cell.tag
+            ))
+            .into());
+        }
+        let rho = if massless[mi] && !layer { 0.0 } else { materials[mi].rho };
+        self.massless_cell[c] = massless[mi] && !layer;
+        match cell.kind {
+            CellKind::Tet4 => {
+                // geometry recomputed in assembly order (not stored twice)
+                let g = tet4::tet_geometry(&tet_x(mesh, cell.nodes())).ok_or_else(|| inverted(mesh, materials, c, mi))?;
+                if let Some(t) = target_w2 {
+                    // a pure massless element (rho 0 here) has no step and no inertia
+                    let s = if rho > 0.0 { mass_scaling::factor(tet4::max_eigenvalue(&g.grad, g.vol, rho, &materials[mi].lame), t) } else { 1.0 };
+                    self.mass_scale[c] = s;
+                    for a in 0..4 {
+                        self.inertial[cell.node(a)] += s * rho * g.vol / 4.0;
+                    }
+                }
+                for a in 0..4 {
+                    self.lump(cell.node(a), rho * g.vol / 4.0, massless[mi]);
+                }
+                self.tn.push(std::array::from_fn(|a| cell.nodes()[a]));
+                self.tm.push(mi as u16);
+                self.tc.push(c as u32);
+            }
+            CellKind::Hex8 => self.add_hex(mesh, materials, massless[mi], target_w2, c, mi, rho)?,
+            CellKind::Tri3 | CellKind::Quad4 => {
+                return Err(ModelError::Invalid(format!("element {} of material group \"{}\" is a face (tri3/quad4): material groups hold volume cells only", cell.tag, materials[mi].group)).into());
+            }
+        }
+        Ok(())
+    }
+
+    /// A hex8 cell `c` of material `mi` with density `rho`: its shape (shared by congruent
+    /// cells of the same material), lumped mass, element.
+    #[allow(clippy::too_many_arguments)]
+    fn add_hex(&mut self, mesh: &Mesh, materials: &[Material], massless: bool, target_w2: Option<f64>, c: usize, mi: usize, rho: f64) -> Result<(), crate::Error> {
+        let cell = &mesh.cells[c];
+        let x: [Vector3<f64>; 8] = std::array::from_fn(|a| mesh.x(cell.node(a)));
+        // congruence key: edge vectors from node 0, rounded to 1e-9 of the element size
+        let size = (x[6] - x[0]).norm();
+        let q = 1e-9 * size;
+        let mut key = [0i64; 21];
+        for a in 1..8 {
+            for i in 0..3 {
+                key[3 * (a - 1) + i] = ((x[a][i] - x[0][i]) / q).round() as i64;
+            }
+        }
+        let id = match self.shape_key.get(&(mi, key)) {
+            Some(&id) => id,
+            None => {
+                let s = hex8::hex_shape(&x, &materials[mi].lame).ok_or_else(|| inverted(mesh, materials, c, mi))?;
+                self.shapes.push(s);
+                let id = (self.shapes.len() - 1) as u32;
+                self.shape_key.insert((mi, key), id);
+                id
+            }
+        };
+        let (vol, mass_frac) = (self.shapes[id as usize].vol, self.shapes[id as usize].mass_frac);
+        if let Some(t) = target_w2 {
+            let f = if rho > 0.0 {
+                if self.shape_w2.len() <= id as usize {
+                    self.shape_w2.resize(id as usize + 1, f64::NAN);
+                }
+                if self.shape_w2[id as usize].is_nan() {
+                    self.shape_w2[id as usize] = hex8::max_eigenvalue(&self.shapes[id as usize], rho, &materials[mi].lame);
+                }
+                mass_scaling::factor(self.shape_w2[id as usize], t)
+            } else {
+                1.0
+            };
+            self.mass_scale[c] = f;
+            for a in 0..8 {
+                self.inertial[cell.node(a)] += f * rho * vol * mass_frac[a];
+            }
+        }
+        for a in 0..8 {
+            self.lump(cell.node(a), rho * vol * mass_frac[a], massless);
+        }
+        self.hn.push(std::array::from_fn(|a| cell.nodes()[a]));
+        self.hs.push(id);
+        self.hm.push(mi as u16);
+        self.hc.push(c as u32);
+        Ok(())
+    }
+
+    /// The element sets in assembly order (colours and chunks: [`assembly_order`]), taken out
+    /// of the scan (its element lists are left empty; the masses stay).
+    fn take_sets(&mut self, mesh: &Mesh) -> Result<(Tet4Set, Hex8Set), ModelError> {
+        self.shape_key = HashMap::new();
+        let (tn, tm, tc) = (std::mem::take(&mut self.tn), std::mem::take(&mut self.tm), std::mem::take(&mut self.tc));
+        let (to, tsched) = assembly_order(&tn, &mesh.nodes)?;
+        let tets = {
+            let nodes = permute(&tn, &to);
+            drop(tn);
+            // the same computation as in the scan on the same coordinates: identical values
+            let geom = nodes.iter().map(|nd| tet4::tet_geometry(&tet_x(mesh, nd)).expect("checked above")).collect();
+            Tet4Set { nodes, geom, mat: permute(&tm, &to), cell: permute(&tc, &to), schedule: tsched }
+        };
+        drop((to, tm, tc));
+        let (hn, hs, hm, hc) = (std::mem::take(&mut self.hn), std::mem::take(&mut self.hs), std::mem::take(&mut self.hm), std::mem::take(&mut self.hc));
+        let (ho, hsched) = assembly_order(&hn, &mesh.nodes)?;
+        let hexes = Hex8Set { nodes: permute(&hn, &ho), shape: permute(&hs, &ho), mat: permute(&hm, &ho), cell: permute(&hc, &ho), schedule: hsched, shapes: std::mem::take(&mut self.shapes) };
+        Ok((tets, hexes))
+    }
+
+    /// Lump `m` [kg] on `node` (and on its massive mass unless the block is massless).
+    fn lump(&mut self, node: usize, m: f64, massless: bool) {
+        self.mass[node] += m;
+        if !massless {
+            self.massive_mass[node] += m;
+        }
+        self.active[node] = true;
+    }
+}
+
+/// The corner points of a tet4 with mesh nodes `nodes`.
+fn tet_x(mesh: &Mesh, nodes: &[u32]) -> [Vector3<f64>; 4] {
+    std::array::from_fn(|a| mesh.x(nodes[a] as usize))
+}
+
+/// The error of an inverted element (cell `c` of material `mi`), with its smallest corner
+/// Jacobian.
+fn inverted(mesh: &Mesh, materials: &[Material], c: usize, mi: usize) -> crate::Error {
+    MeshError::InvertedElement { path: mesh.source.clone(), group: materials[mi].group.clone(), element: mesh.cells[c].tag, jacobian: mesh.min_corner_jacobian(c) }.into()
+}
+
+/// The fixed components of every node (bits x = 1, y = 2, z = 4; a node of no element: all
+/// three) and the condensed ones (the nodes of massless elements without mass, less the
+/// components the scene's `boundary` fixes).
+fn supports(mesh: &Mesh, scene: &Scene, active: &[bool], mass: &[f64], massless_cell: &[bool]) -> Result<(Vec<u8>, Vec<u8>), crate::Error> {
+    let mut fixed: Vec<u8> = active.iter().map(|&a| if a { 0 } else { 7 }).collect();
+    // nodes of the massless elements (without mass: condensed)
+    let mut condensed = vec![0u8; mesh.nodes.len()];
+    for (c, &ml) in massless_cell.iter().enumerate() {
+        if ml {
+            for &v in mesh.cells[c].nodes() {
+                if mass[v as usize] == 0.0 {
+                    condensed[v as usize] = 7;
+                }
+            }
+        }
+    }
+    for b in &scene.boundary {
+        let bits = b.fix.iter().fold(0u8, |acc, c| acc | match c.as_str() { "x" => 1, "y" => 2, _ => 4 });
+        for node in mesh.group_nodes(&b.group)? {
+            fixed[node] |= bits;
+            condensed[node] &= !bits;
+        }
+    }
+    Ok((fixed, condensed))
+}
+
+/// The summary of the scene's mass scaling (`None` without `time.mass_scaling`): the scaled
+/// elements, the largest factor and its element, the mass added (the scaled total minus the
+/// unscaled one).
+fn mass_scaling_summary(mesh: &Mesh, scene: &Scene, mass_scale: &[f64], mass: &[f64], inertial: &[f64]) -> Option<MassScaling> {
+    scene.time.mass_scaling.as_ref().map(|ms| {
+        let (mut count, mut max_factor, mut max_cell) = (0usize, 1.0, None);
+        for (c, &f) in mass_scale.iter().enumerate() {
+            if f > 1.0 {
+                count += 1;
+                if f > max_factor {
+                    (max_factor, max_cell) = (f, Some(c));
+                }
+            }
+        }
+        // added = Σ (s − 1) ρ V: the scaled total minus the unscaled one
+        let total: f64 = mass.iter().sum();
+        let added = if count > 0 { inertial.iter().sum::<f64>() - total } else { 0.0 };
+        MassScaling {
+            target_dt: ms.target_dt,
+            element_dt: ms.target_dt / scene.time.courant_or_default(),
+            scaled_elements: count,
+            added_mass: added,
+            total_mass: total,
+            max_factor,
+            max_factor_element: max_cell.map(|c| mesh.cells[c].tag).unwrap_or(0),
+        }
+    })
+}
+
+/// The nodes that carry the mass-proportional damping: all, or those of the scene's
+/// `damping.mass_groups` (volume groups).
+fn mass_damped_nodes(mesh: &Mesh, scene: &Scene) -> Result<Vec<bool>, crate::Error> {
+    Ok(match &scene.damping.mass_groups {
+        None => vec![true; mesh.nodes.len()],
+        Some(groups) => {
+            let mut d = vec![false; mesh.nodes.len()];
+            for g in groups {
+                mesh.group_of_dim(g, 3)?;
+                for node in mesh.group_nodes(g)? {
+                    d[node] = true;
+                }
+            }
+            d
+        }
+    })
 }

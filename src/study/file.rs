@@ -196,13 +196,7 @@ impl Study {
             None => return Err(invalid("`report` needs a `kind` (e.g. \"wedge\", \"incline\", \"runs\")".into())),
             Some(v) => return Err(invalid(format!("`report.kind` = {v}: must be a string"))),
         };
-        let only_for_values = |v: &Variation, field: &str| -> Result<(), StudyError> {
-            if v.label.is_some() || v.cost.is_some() {
-                return Err(invalid(format!("`{field}`: `label` and `cost` belong to axis values only")));
-            }
-            check_variation(v, field).map_err(invalid)
-        };
-        only_for_values(&f.all, "all")?;
+        only_for_values(path, &f.all, "all")?;
         if f.axes.is_empty() {
             return Err(invalid("`axes`: give at least one axis (a name and its values)".into()));
         }
@@ -218,41 +212,7 @@ impl Study {
             if a.values.is_empty() {
                 return Err(invalid(format!("{at}: `values` is empty")));
             }
-            let mut values: Vec<AxisValue> = Vec::new();
-            for (k, v) in a.values.iter().enumerate() {
-                let vat = format!("{at}.values[{k}]");
-                let value = match v {
-                    Value::Object(_) => {
-                        let var: Variation = serde_json::from_value(v.clone()).map_err(|e| invalid(format!("{vat}: {e}")))?;
-                        let label = var.label.clone().ok_or_else(|| invalid(format!("{vat}: an object value needs a `label` (its part of the run id; \"\" for none)")))?;
-                        let cost = var.cost.unwrap_or(1.0);
-                        AxisValue { label, cost, variation: Variation { label: None, cost: None, ..var } }
-                    }
-                    Value::Number(_) | Value::String(_) => {
-                        let field = a.field.as_deref().ok_or_else(|| invalid(format!("{vat}: a bare value {v} needs the axis' `field` (pga, scale, set.<name>, joints.<field> or a scene path /…); or give an object with a `label`")))?;
-                        let label = match v {
-                            Value::Number(n) => format!("{}{}", a.name, number_label(n.as_f64().unwrap_or(f64::NAN), a.decimals)),
-                            Value::String(s) => s.clone(),
-                            _ => unreachable!(),
-                        };
-                        let variation = field_variation(field, v).map_err(|m| invalid(format!("{at}: `field` = \"{field}\": {m}")))?;
-                        AxisValue { label, cost: 1.0, variation }
-                    }
-                    other => return Err(invalid(format!("{vat}: {other} is neither a number, a string nor an object"))),
-                };
-                if !label_ok(&value.label) {
-                    return Err(invalid(format!("{vat}: label \"{}\": use letters, digits, `.`, `_`, `+` (it goes into file names)", value.label)));
-                }
-                if values.iter().any(|o| o.label == value.label) {
-                    return Err(invalid(format!("{vat}: label \"{}\" is given twice on this axis", value.label)));
-                }
-                if !(value.cost.is_finite() && value.cost > 0.0) {
-                    return Err(invalid(format!("{vat}: `cost` = {} must be a positive number", value.cost)));
-                }
-                check_variation(&value.variation, &vat).map_err(invalid)?;
-                values.push(value);
-            }
-            axes.push(Axis { name: a.name.clone(), values });
+            axes.push(read_axis(path, a, &at)?);
         }
         let axis_index = |n: &str, at: &str| -> Result<usize, StudyError> {
             axes.iter().position(|a| a.name == n).ok_or_else(|| {
@@ -274,46 +234,110 @@ impl Study {
             }
             None => (0..axes.len()).collect(),
         };
-        let mut selections = Vec::new();
-        match &f.runs {
-            None => selections.push(Selection { labels: axes.iter().map(|a| a.values.iter().map(|v| v.label.clone()).collect()).collect(), with: Variation::default() }),
-            Some(list) => {
-                if list.is_empty() {
-                    return Err(invalid("`runs` is empty: leave it out for the product of all axes".into()));
-                }
-                for (i, s) in list.iter().enumerate() {
-                    let at = format!("runs[{i}]");
-                    let mut labels: Vec<Vec<String>> = axes.iter().map(|a| vec![a.values[0].label.clone()]).collect();
-                    for (name, v) in &s.axes {
-                        let k = axis_index(name, &format!("{at}.axes"))?;
-                        let known = || axes[k].values.iter().map(|x| format!("\"{}\"", x.label)).collect::<Vec<_>>().join(", ");
-                        let list: Vec<String> = match v {
-                            Value::String(s) if s == "*" => axes[k].values.iter().map(|x| x.label.clone()).collect(),
-                            Value::String(s) => vec![s.clone()],
-                            Value::Array(a) => a.iter().map(|x| x.as_str().map(str::to_string).ok_or_else(|| invalid(format!("{at}.axes.{name}: {x} is not a label (a string)")))).collect::<Result<_, _>>()?,
-                            other => return Err(invalid(format!("{at}.axes.{name}: {other}: give a label, a list of labels or \"*\""))),
-                        };
-                        for l in &list {
-                            if axes[k].value(l).is_none() {
-                                return Err(invalid(format!("{at}.axes.{name}: no value labelled \"{l}\" (labels: {})", known())));
-                            }
-                        }
-                        if list.is_empty() {
-                            return Err(invalid(format!("{at}.axes.{name}: an empty list selects no run")));
-                        }
-                        labels[k] = list;
-                    }
-                    only_for_values(&s.with, &format!("{at}.with"))?;
-                    selections.push(Selection { labels, with: s.with.clone() });
-                }
-            }
-        }
+        let selections = read_selections(path, f.runs.as_deref(), &axes)?;
         Ok(Study { path: path.to_path_buf(), name, scene, out, kind, params: report, all: f.all.clone(), axes, id_axes, selections })
     }
 
     pub fn axis(&self, name: &str) -> Option<&Axis> {
         self.axes.iter().find(|a| a.name == name)
     }
+}
+
+/// A variation that is not an axis value (`all`, a selection's `with`): no `label`, no `cost`,
+/// and the checks of every variation.
+fn only_for_values(path: &Path, v: &Variation, field: &str) -> Result<(), StudyError> {
+    let invalid = |message: String| StudyError::Invalid { path: path.to_path_buf(), message };
+    if v.label.is_some() || v.cost.is_some() {
+        return Err(invalid(format!("`{field}`: `label` and `cost` belong to axis values only")));
+    }
+    check_variation(v, field).map_err(invalid)
+}
+
+/// One axis of the study file (`at` names it in errors): its values, labelled, costed and
+/// checked (labels file-safe and distinct, costs positive).
+fn read_axis(path: &Path, a: &AxisFile, at: &str) -> Result<Axis, StudyError> {
+    let invalid = |message: String| StudyError::Invalid { path: path.to_path_buf(), message };
+    let mut values: Vec<AxisValue> = Vec::new();
+    for (k, v) in a.values.iter().enumerate() {
+        let vat = format!("{at}.values[{k}]");
+        let value = match v {
+            Value::Object(_) => {
+                let var: Variation = serde_json::from_value(v.clone()).map_err(|e| invalid(format!("{vat}: {e}")))?;
+                let label = var.label.clone().ok_or_else(|| invalid(format!("{vat}: an object value needs a `label` (its part of the run id; \"\" for none)")))?;
+                let cost = var.cost.unwrap_or(1.0);
+                AxisValue { label, cost, variation: Variation { label: None, cost: None, ..var } }
+            }
+            Value::Number(_) | Value::String(_) => {
+                let field = a.field.as_deref().ok_or_else(|| invalid(format!("{vat}: a bare value {v} needs the axis' `field` (pga, scale, set.<name>, joints.<field> or a scene path /…); or give an object with a `label`")))?;
+                let label = match v {
+                    Value::Number(n) => format!("{}{}", a.name, number_label(n.as_f64().unwrap_or(f64::NAN), a.decimals)),
+                    Value::String(s) => s.clone(),
+                    _ => unreachable!(),
+                };
+                let variation = field_variation(field, v).map_err(|m| invalid(format!("{at}: `field` = \"{field}\": {m}")))?;
+                AxisValue { label, cost: 1.0, variation }
+            }
+            other => return Err(invalid(format!("{vat}: {other} is neither a number, a string nor an object"))),
+        };
+        if !label_ok(&value.label) {
+            return Err(invalid(format!("{vat}: label \"{}\": use letters, digits, `.`, `_`, `+` (it goes into file names)", value.label)));
+        }
+        if values.iter().any(|o| o.label == value.label) {
+            return Err(invalid(format!("{vat}: label \"{}\" is given twice on this axis", value.label)));
+        }
+        if !(value.cost.is_finite() && value.cost > 0.0) {
+            return Err(invalid(format!("{vat}: `cost` = {} must be a positive number", value.cost)));
+        }
+        check_variation(&value.variation, &vat).map_err(invalid)?;
+        values.push(value);
+    }
+    Ok(Axis { name: a.name.clone(), values })
+}
+
+/// The run selections of the study file (`None`: the product of all axes), each label checked
+/// against its axis.
+fn read_selections(path: &Path, runs: Option<&[SelectionFile]>, axes: &[Axis]) -> Result<Vec<Selection>, StudyError> {
+    let invalid = |message: String| StudyError::Invalid { path: path.to_path_buf(), message };
+    let axis_index = |n: &str, at: &str| -> Result<usize, StudyError> {
+        axes.iter().position(|a| a.name == n).ok_or_else(|| {
+            invalid(format!("{at}: no axis \"{n}\" (axes: {})", axes.iter().map(|a| a.name.as_str()).collect::<Vec<_>>().join(", ")))
+        })
+    };
+    let mut selections = Vec::new();
+    match runs {
+        None => selections.push(Selection { labels: axes.iter().map(|a| a.values.iter().map(|v| v.label.clone()).collect()).collect(), with: Variation::default() }),
+        Some(list) => {
+            if list.is_empty() {
+                return Err(invalid("`runs` is empty: leave it out for the product of all axes".into()));
+            }
+            for (i, s) in list.iter().enumerate() {
+                let at = format!("runs[{i}]");
+                let mut labels: Vec<Vec<String>> = axes.iter().map(|a| vec![a.values[0].label.clone()]).collect();
+                for (name, v) in &s.axes {
+                    let k = axis_index(name, &format!("{at}.axes"))?;
+                    let known = || axes[k].values.iter().map(|x| format!("\"{}\"", x.label)).collect::<Vec<_>>().join(", ");
+                    let list: Vec<String> = match v {
+                        Value::String(s) if s == "*" => axes[k].values.iter().map(|x| x.label.clone()).collect(),
+                        Value::String(s) => vec![s.clone()],
+                        Value::Array(a) => a.iter().map(|x| x.as_str().map(str::to_string).ok_or_else(|| invalid(format!("{at}.axes.{name}: {x} is not a label (a string)")))).collect::<Result<_, _>>()?,
+                        other => return Err(invalid(format!("{at}.axes.{name}: {other}: give a label, a list of labels or \"*\""))),
+                    };
+                    for l in &list {
+                        if axes[k].value(l).is_none() {
+                            return Err(invalid(format!("{at}.axes.{name}: no value labelled \"{l}\" (labels: {})", known())));
+                        }
+                    }
+                    if list.is_empty() {
+                        return Err(invalid(format!("{at}.axes.{name}: an empty list selects no run")));
+                    }
+                    labels[k] = list;
+                }
+                only_for_values(path, &s.with, &format!("{at}.with"))?;
+                selections.push(Selection { labels, with: s.with.clone() });
+            }
+        }
+    }
+    Ok(selections)
 }
 
 /// The variation a bare axis value stands for.

@@ -333,7 +333,7 @@ impl CaseSpec {
             return Err(invalid("layer", format!("{layer}: use 1 or 2")));
         }
         let mu = self.mu.unwrap_or(match k {
-            Kind::Patch => 0.6,
+            Kind::Patch => crate::scene::DEFAULT_FRICTION,
             Kind::Slide => 0.3,
             Kind::Newmark => 35f64.to_radians().tan(),
             Kind::Impact => 0.0,
@@ -397,25 +397,7 @@ impl CaseSpec {
         if !(rotate.is_finite() && rotate.abs() <= 45.0) {
             return Err(invalid("rotate", format!("{rotate}: give |θ| ≤ 45 deg")));
         }
-        if let Some(rc) = self.curvature {
-            if k != Kind::Patch {
-                return Err(invalid("curvature", "only the patch kind has a cylindrical joint"));
-            }
-            if !(rc.is_finite() && rc.abs() > 0.5 * PATCH_SIDE) {
-                return Err(invalid("curvature", format!("R = {rc}: give |R| > {} m (the joint's half-width)", 0.5 * PATCH_SIDE)));
-            }
-            if shear != 0.0 || rotate != 0.0 || self.massless_lower {
-                return Err(invalid("curvature", "a cylindrical joint takes the pressure state only: no shear, rotate or massless_lower"));
-            }
-            if pressure == 0.0 {
-                return Err(invalid("curvature", "give a pressure p > 0"));
-            }
-            let c = 0.5 * PATCH_SIDE;
-            let slope = c / (rc * rc - c * c).sqrt();
-            if !self.tied && mu <= slope {
-                return Err(invalid("curvature", format!("R = {rc}: the joint's steepest slope tan α = {slope:.4} ≥ μ = {mu}: the blocks would slide (no static solution); raise μ, |R|, or use tied")));
-            }
-        }
+        self.check_curvature(k, mu, pressure, shear, rotate)?;
         if self.massless_lower && slave == Side::Lower && !self.tied && method == ContactMethod::Ntn {
             return Err(invalid("massless_lower", "NTN on a massless side is not a supported combination; use nts"));
         }
@@ -426,6 +408,30 @@ impl CaseSpec {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
         Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, record, pga })
+    }
+
+    /// The cylindrical joint (`curvature` R), if any: a patch case, |R| above the joint's
+    /// half-width, the pressure state only, and μ above the steepest slope unless tied.
+    fn check_curvature(&self, k: Kind, mu: f64, pressure: f64, shear: f64, rotate: f64) -> Result<(), Error> {
+        let Some(rc) = self.curvature else { return Ok(()) };
+        if k != Kind::Patch {
+            return Err(invalid("curvature", "only the patch kind has a cylindrical joint"));
+        }
+        if !(rc.is_finite() && rc.abs() > 0.5 * PATCH_SIDE) {
+            return Err(invalid("curvature", format!("R = {rc}: give |R| > {} m (the joint's half-width)", 0.5 * PATCH_SIDE)));
+        }
+        if shear != 0.0 || rotate != 0.0 || self.massless_lower {
+            return Err(invalid("curvature", "a cylindrical joint takes the pressure state only: no shear, rotate or massless_lower"));
+        }
+        if pressure == 0.0 {
+            return Err(invalid("curvature", "give a pressure p > 0"));
+        }
+        let c = 0.5 * PATCH_SIDE;
+        let slope = c / (rc * rc - c * c).sqrt();
+        if !self.tied && mu <= slope {
+            return Err(invalid("curvature", format!("R = {rc}: the joint's steepest slope tan α = {slope:.4} ≥ μ = {mu}: the blocks would slide (no static solution); raise μ, |R|, or use tied")));
+        }
+        Ok(())
     }
 }
 

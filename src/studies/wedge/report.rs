@@ -14,7 +14,7 @@
 //!   is added when the slip exceeds 10 % of the line of intersection (the wedge has moved out
 //!   of its bed: contact area and support are no longer those of limit equilibrium).
 
-use super::{StudySsr, WedgeKind};
+use super::{StudySsr, WedgeKind, WedgeParams};
 use crate::dynamics::loads::base_motions;
 use crate::error::{Error, OutputError};
 use crate::output::history::HistoryTable;
@@ -25,7 +25,7 @@ use crate::studies::wedge::rigid_level::{rigid_wedge_slip, sample_ground_motion,
 use crate::study::{scene_for, KindReport, RunCharts, RunResult, StudyResults, Variation};
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A monitored point's history: time, displacement and acceleration (relative to the base).
 #[derive(Clone, Debug, Default)]
@@ -515,28 +515,160 @@ fn cm3(u: [f64; 3]) -> String {
     format!("({}, {}, {}) cm", fmt_sig(u[0] * 100.0, 3), fmt_sig(u[1] * 100.0, 3), fmt_sig(u[2] * 100.0, 3))
 }
 
+/// What the sections of the wedge report share: the study, its runs as read, the rigid level
+/// at every PGA, and the headline's choices. Built once by [`write`].
+struct Ctx<'a> {
+    prm: &'a WedgeParams,
+    results: &'a StudyResults<'a>,
+    base: &'a Scene,
+    runs: Vec<WedgeRun>,
+    /// Failed runs whose histories cannot be read (stopped before the first step): listed with
+    /// the stopped runs.
+    stopped_early: Vec<(String, String)>,
+    rigid: Vec<RigidAtPga>,
+    pgas: Vec<f64>,
+    /// The mesh level of the PGA sweep and of the reference.
+    sweep: String,
+    reference: String,
+    /// The headline: the base scene's rock, law and stiffness-proportional damping β [s].
+    main_rock: RockModel,
+    main_law: CohesionLaw,
+    main_beta: f64,
+    /// The variant law (the first law of the runs that is not the headline's), if any.
+    other_law: Option<CohesionLaw>,
+    /// The accuracy PGA [g].
+    acc: f64,
+    charts_dir: PathBuf,
+}
+
+impl Ctx<'_> {
+    fn rigid_of(&self, pga: f64) -> &RigidAtPga {
+        self.rigid.iter().find(|r| r.pga == pga).expect("rigid level of every PGA")
+    }
+
+    /// The rigid block's residual slip at `pga` with the headline's law [m].
+    fn rigid_main(&self, pga: f64) -> f64 {
+        self.rigid_of(pga).bond(self.main_law).result.residual_displacement
+    }
+
+    /// A headline run (the main rock, law and damping, E as given).
+    fn plain(&self, s: &WedgeRunSpec) -> bool {
+        s.e_factor == 1.0 && s.rock == self.main_rock && s.law == self.main_law && s.beta == self.main_beta
+    }
+
+    /// The reference level's headline run.
+    fn is_ref(&self, s: &WedgeRunSpec) -> bool {
+        self.plain(s) && s.mesh == self.reference && s.method == "nts" && s.layer == self.prm.reference.layer
+    }
+
+    /// A run of the variant law (otherwise as the headline).
+    fn variant(&self, s: &WedgeRunSpec) -> bool {
+        Some(s.law) == self.other_law && s.e_factor == 1.0 && s.rock == self.main_rock && s.beta == self.main_beta
+    }
+
+    /// The first run that did not fail among those `pred` selects.
+    fn run_of(&self, pred: &dyn Fn(&WedgeRunSpec) -> bool) -> Option<&WedgeRun> {
+        find(&self.runs, pred).filter(|r| r.failed.is_none())
+    }
+
+    /// |residual slip| against PGA of the runs of one level (`method`, `mesh`, `layer`) that
+    /// `sel` selects.
+    fn pts(&self, method: &str, mesh: &str, layer: u8, sel: &dyn Fn(&WedgeRunSpec) -> bool) -> Vec<(f64, f64)> {
+        self.pgas
+            .iter()
+            .filter_map(|&p| self.run_of(&|s| sel(s) && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer).map(|r| (p, r.residual_slip.abs())))
+            .collect()
+    }
+
+    /// The runs on a rock model other than the headline's.
+    fn other_rock(&self) -> Vec<&WedgeRun> {
+        self.runs.iter().filter(|r| r.spec.rock != self.main_rock).collect()
+    }
+
+    /// The other rock models, in the order of the runs.
+    fn other_rocks(&self) -> Vec<RockModel> {
+        self.other_rock().iter().fold(Vec::new(), |mut v, r| {
+            if !v.contains(&r.spec.rock) {
+                v.push(r.spec.rock);
+            }
+            v
+        })
+    }
+
+    /// The joint names as the tables' column heads write them ("A / B").
+    fn joint_names(&self) -> String {
+        self.base.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(" / ")
+    }
+}
+
+/// Residual slip against PGA of the headline's levels, the rigid block and the variant law.
+struct Curves {
+    nts_sweep: Vec<(f64, f64)>,
+    ntn_sweep: Vec<(f64, f64)>,
+    nts2_sweep: Vec<(f64, f64)>,
+    reference_pts: Vec<(f64, f64)>,
+    rigid_kept_pts: Vec<(f64, f64)>,
+    nts_var: Vec<(f64, f64)>,
+    ntn_var: Vec<(f64, f64)>,
+}
+
+impl Curves {
+    fn of(ctx: &Ctx<'_>) -> Curves {
+        let plain = |s: &WedgeRunSpec| ctx.plain(s);
+        let variant = |s: &WedgeRunSpec| ctx.variant(s);
+        let sweep = &ctx.sweep;
+        Curves {
+            nts_sweep: ctx.pts("nts", sweep, 1, &plain),
+            ntn_sweep: ctx.pts("ntn", sweep, 1, &plain),
+            nts2_sweep: ctx.pts("nts", sweep, 2, &plain),
+            reference_pts: ctx.pts("nts", &ctx.reference, ctx.prm.reference.layer, &plain),
+            rigid_kept_pts: ctx.pgas.iter().map(|&p| (p, ctx.rigid_main(p))).collect(),
+            nts_var: ctx.pts("nts", sweep, 1, &variant),
+            ntn_var: ctx.pts("ntn", sweep, 1, &variant),
+        }
+    }
+
+    /// Whether the variant law has runs to report.
+    fn has_variant(&self) -> bool {
+        !self.nts_var.is_empty() || !self.ntn_var.is_empty()
+    }
+}
+
+/// The headline runs at the accuracy PGA: NTS-L1 and NTN on the sweep mesh, the reference.
+struct AtAcc<'r> {
+    nts: Option<&'r WedgeRun>,
+    ntn: Option<&'r WedgeRun>,
+    reference: Option<&'r WedgeRun>,
+}
+
+impl<'r> AtAcc<'r> {
+    fn of(ctx: &'r Ctx<'_>) -> AtAcc<'r> {
+        let acc = ctx.acc;
+        AtAcc {
+            nts: ctx.run_of(&|s| ctx.plain(s) && s.pga == acc && s.method == "nts" && s.mesh == ctx.sweep && s.layer == 1),
+            ntn: ctx.run_of(&|s| ctx.plain(s) && s.pga == acc && s.method == "ntn" && s.mesh == ctx.sweep),
+            reference: ctx.run_of(&|s| ctx.is_ref(s) && s.pga == acc),
+        }
+    }
+}
+
+/// The levels' cost and error at the accuracy PGA: (level, wall time [s], slip [m], |error|
+/// against the reference [-]) and the indices of the Pareto front.
+struct SpeedAccuracy {
+    levels: Vec<(String, f64, f64, f64)>,
+    front: Vec<usize>,
+}
+
 /// The wedge study's part of the report (`report.md`, the `report` of `report.json`, the
-/// charts in `<out>/charts/`).
+/// charts in `<out>/charts/`). One function per section: the charts (`chart_*`) in the order
+/// the report lists them, then the Markdown sections (`section_*`) in the order of the page.
 pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Error> {
     let prm = &kind.params;
     let study = results.study;
-    let out = results.plan.out.clone();
     let base = &results.base;
     let geom = build_wedge(&prm.wedge)?;
-    let e = geom.e;
     let line_length = (geom.p[0].powi(2) + geom.p[1].powi(2) + geom.p[2].powi(2)).sqrt();
-    let mut runs = Vec::new();
-    let mut unreadable = Vec::new();
-    // failed runs whose histories cannot be read (stopped before the first step): listed
-    // with the stopped runs
-    let mut stopped_early = Vec::new();
-    for res in results.runs.iter().filter(|r| r.has_results()) {
-        match (read_run(kind, res, base, e, line_length), res.failed()) {
-            (Ok(r), _) => runs.push(r),
-            (Err(_), Some(f)) => stopped_early.push((res.spec.id.clone(), f.to_string())),
-            (Err(err), None) => unreadable.push((res.spec.id.clone(), err.to_string())),
-        }
-    }
+    let (runs, stopped_early, mut unreadable) = read_runs(kind, results, geom.e, line_length);
     let ssr: Option<StudySsr> = match results.step::<StudySsr>("ssr") {
         Ok(s) => s,
         Err(e) => {
@@ -564,154 +696,222 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         kc_residual: rigid[0].brittle.kc_residual,
         line_length,
     };
-    let charts_dir = out.join("charts");
-    let mut charts = Vec::new();
-    let sweep = prm.sweep_mesh.clone();
-    let reference = prm.reference.mesh.clone();
-    let rigid_of = |pga: f64| rigid.iter().find(|r| r.pga == pga).expect("rigid level of every PGA");
     // the headline: the base scene's law, damping and stiffness on the main rock
-    let main_rock = kind.main_rock();
     let main_law = base.joints.first().map(CohesionLaw::of).unwrap_or(CohesionLaw::Brittle);
-    let main_beta = stiffness_damping(base);
-    let rigid_main = |p: f64| rigid_of(p).bond(main_law).result.residual_displacement;
-    let plain = |s: &WedgeRunSpec| s.e_factor == 1.0 && s.rock == main_rock && s.law == main_law && s.beta == main_beta;
-    let is_ref = |s: &WedgeRunSpec| plain(s) && s.mesh == reference && s.method == "nts" && s.layer == prm.reference.layer;
-    let run_of = |pred: &dyn Fn(&WedgeRunSpec) -> bool| find(&runs, pred).filter(|r| r.failed.is_none());
-    // the variant law (the first law of the runs that is not the headline's), if any
     let other_law = runs.iter().map(|r| r.spec.law).find(|l| *l != main_law);
-    let acc = prm.accuracy_pga;
-
-    // ---- slip against PGA: the headline, the seed's values
-    let pts = |method: &str, mesh: &str, layer: u8, sel: &dyn Fn(&WedgeRunSpec) -> bool| -> Vec<(f64, f64)> {
-        pgas.iter()
-            .filter_map(|&p| run_of(&|s| sel(s) && s.pga == p && s.method == method && s.mesh == mesh && s.layer == layer).map(|r| (p, r.residual_slip.abs())))
-            .collect()
+    let ctx = Ctx {
+        prm,
+        results,
+        base,
+        runs,
+        stopped_early,
+        rigid,
+        pgas,
+        sweep: prm.sweep_mesh.clone(),
+        reference: prm.reference.mesh.clone(),
+        main_rock: kind.main_rock(),
+        main_law,
+        main_beta: stiffness_damping(base),
+        other_law,
+        acc: prm.accuracy_pga,
+        charts_dir: results.plan.out.join("charts"),
     };
-    let nts_sweep = pts("nts", &sweep, 1, &plain);
-    let ntn_sweep = pts("ntn", &sweep, 1, &plain);
-    let nts2_sweep = pts("nts", &sweep, 2, &plain);
-    let reference_pts = pts("nts", &reference, prm.reference.layer, &plain);
-    let rigid_kept_pts: Vec<(f64, f64)> = pgas.iter().map(|&p| (p, rigid_main(p))).collect();
+    let curves = Curves::of(&ctx);
+    let at = AtAcc::of(&ctx);
+    let sa = speed_accuracy(&ctx, &at);
+    let mut charts = vec![chart_slip_vs_pga(&ctx, &curves)?];
+    charts.extend(chart_slip_vs_pga_variant(&ctx, &curves)?);
+    charts.extend(chart_slip_vs_pga_rock(&ctx)?);
+    charts.push(chart_slip_history(&ctx, &at)?);
+    charts.push(chart_p1_history(&ctx, &at)?);
+    charts.push(chart_speed_accuracy(&ctx, &sa)?);
+    charts.extend(chart_ssr(&ctx, ssr.as_ref())?);
+    let cheapest = cheapest_levels(&ctx);
+    let trend = trends(&ctx, &curves);
+    let claims = seed_claims(&ctx, &curves, &at);
+
+    let mut md = String::new();
+    section_model(&mut md, &ctx);
+    section_static_fs(&mut md, &le, ssr.as_ref());
+    section_headline(&mut md, &ctx, &curves, &at);
+    section_claims(&mut md, &claims, &trend);
+    section_headline_detail(&mut md, &ctx);
+    section_variant(&mut md, &ctx, &curves);
+    section_rock(&mut md, &ctx);
+    section_stiffness(&mut md, &ctx);
+    section_speed_accuracy(&mut md, &ctx, &sa, at.reference, &cheapest, ssr.is_some());
+    section_runs(&mut md, &ctx, ssr.as_ref());
+    let mut lines = trend.clone();
+    lines.extend(claims.iter().map(|c| format!("seed: {} — seed {}, ours {} ({})", c.claim, c.seed, c.ours, match c.reproduced {
+        Some(true) => "reproduced",
+        Some(false) => "not reproduced",
+        None => "compare",
+    })));
+    let Ctx { runs, rigid, main_law, main_beta, .. } = ctx;
+    let rep = WedgeReport { le, ssr, runs, rigid, cheapest, trend, claims, headline_law: main_law, headline_beta: main_beta };
+    Ok(KindReport { markdown: md, json: serde_json::to_value(&rep).expect("the report serialises"), charts, lines, unreadable, lists_failed: true })
+}
+
+/// The runs with results, read: (the runs read, failed runs whose histories cannot be read as
+/// (id, why), unreadable runs as (id, why)).
+#[allow(clippy::type_complexity)]
+fn read_runs(kind: &WedgeKind, results: &StudyResults, e: [f64; 3], line_length: f64) -> (Vec<WedgeRun>, Vec<(String, String)>, Vec<(String, String)>) {
+    let mut runs = Vec::new();
+    let mut unreadable = Vec::new();
+    let mut stopped_early = Vec::new();
+    for res in results.runs.iter().filter(|r| r.has_results()) {
+        match (read_run(kind, res, &results.base, e, line_length), res.failed()) {
+            (Ok(r), _) => runs.push(r),
+            (Err(_), Some(f)) => stopped_early.push((res.spec.id.clone(), f.to_string())),
+            (Err(err), None) => unreadable.push((res.spec.id.clone(), err.to_string())),
+        }
+    }
+    (runs, stopped_early, unreadable)
+}
+
+// ---- charts ---------------------------------------------------------------------------------
+
+/// Chart: slip against PGA, the headline's levels, the rigid block and the seed's values.
+fn chart_slip_vs_pga(ctx: &Ctx<'_>, cv: &Curves) -> Result<PathBuf, Error> {
+    let (sweep, reference, main_law) = (&ctx.sweep, &ctx.reference, ctx.main_law);
     let mut c = Chart::new(format!("Residual slip at P2 against PGA — {}", main_law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), nts_sweep.clone()));
-    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), ntn_sweep.clone()));
-    if !nts2_sweep.is_empty() {
-        c.series.push(Series::line_markers(format!("NTS-L2, {sweep} mesh"), nts2_sweep.clone()));
+    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), cv.nts_sweep.clone()));
+    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), cv.ntn_sweep.clone()));
+    if !cv.nts2_sweep.is_empty() {
+        c.series.push(Series::line_markers(format!("NTS-L2, {sweep} mesh"), cv.nts2_sweep.clone()));
     }
-    if reference != sweep && !reference_pts.is_empty() {
-        c.series.push(Series::markers(format!("NTS-L{}, {reference} mesh (reference)", prm.reference.layer), reference_pts.clone()));
+    if reference != sweep && !cv.reference_pts.is_empty() {
+        c.series.push(Series::markers(format!("NTS-L{}, {reference} mesh (reference)", ctx.prm.reference.layer), cv.reference_pts.clone()));
     }
-    c.series.push(Series::line_markers(format!("rigid block, {}", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), rigid_kept_pts.clone()));
+    c.series.push(Series::line_markers(format!("rigid block, {}", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), cv.rigid_kept_pts.clone()));
     c.series.push(Series::markers("seed NTS (Koyna record)", [(seed::PGA, seed::SLIP_NTS_1G)]));
     c.series.push(Series::markers("seed NTN (Koyna record)", [(seed::PGA, seed::SLIP_NTN_1G)]));
-    charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga"))?.png);
+    Ok(c.write_png_svg(&ctx.charts_dir.join("slip_vs_pga"))?.png)
+}
 
-    // ---- the variant law
-    let variant = |s: &WedgeRunSpec| Some(s.law) == other_law && s.e_factor == 1.0 && s.rock == main_rock && s.beta == main_beta;
-    let nts_var = pts("nts", &sweep, 1, &variant);
-    let ntn_var = pts("ntn", &sweep, 1, &variant);
-    if let Some(law) = other_law.filter(|_| !nts_var.is_empty() || !ntn_var.is_empty()) {
-        let mut c = Chart::new(format!("Residual slip at P2 against PGA — variant: {}", law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), nts_var.clone()));
-        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), ntn_var.clone()));
-        c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", pgas.iter().map(|&p| (p, rigid_of(p).bond(law).result.residual_displacement))));
-        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {} (headline)", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "headline law" }), nts_sweep.clone()));
-        charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga_variant"))?.png);
+/// Chart: slip against PGA with the variant law (none without variant runs).
+fn chart_slip_vs_pga_variant(ctx: &Ctx<'_>, cv: &Curves) -> Result<Option<PathBuf>, Error> {
+    let Some(law) = ctx.other_law.filter(|_| cv.has_variant()) else { return Ok(None) };
+    let (sweep, main_law) = (&ctx.sweep, ctx.main_law);
+    let mut c = Chart::new(format!("Residual slip at P2 against PGA — variant: {}", law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), cv.nts_var.clone()));
+    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), cv.ntn_var.clone()));
+    c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", ctx.pgas.iter().map(|&p| (p, ctx.rigid_of(p).bond(law).result.residual_displacement))));
+    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {} (headline)", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "headline law" }), cv.nts_sweep.clone()));
+    Ok(Some(c.write_png_svg(&ctx.charts_dir.join("slip_vs_pga_variant"))?.png))
+}
+
+/// Chart: slip against PGA of the other rock models against the main rock (none without
+/// other rock models).
+fn chart_slip_vs_pga_rock(ctx: &Ctx<'_>) -> Result<Option<PathBuf>, Error> {
+    let other_rock = ctx.other_rock();
+    if other_rock.is_empty() {
+        return Ok(None);
     }
-
-    // ---- other rock models: each run against its main-rock twin
-    let twin_of = |r: &WedgeRun| {
-        run_of(&|s: &WedgeRunSpec| s.rock == main_rock && s.pga == r.spec.pga && s.method == r.spec.method && s.layer == r.spec.layer && s.mesh == r.spec.mesh && s.law == r.spec.law && s.e_factor == r.spec.e_factor && s.beta == r.spec.beta)
-    };
-    let other_rock: Vec<&WedgeRun> = runs.iter().filter(|r| r.spec.rock != main_rock).collect();
-    if !other_rock.is_empty() {
-        let mut c = Chart::new("Residual slip at P2 against PGA: rock models", "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-        let mut keys: Vec<(String, String, u8, RockModel)> = Vec::new();
-        for r in &other_rock {
-            let k = (r.spec.method.clone(), r.spec.mesh.clone(), r.spec.layer, r.spec.rock);
-            if !keys.contains(&k) {
-                keys.push(k);
-            }
+    let mut c = Chart::new("Residual slip at P2 against PGA: rock models", "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+    let mut keys: Vec<(String, String, u8, RockModel)> = Vec::new();
+    for r in &other_rock {
+        let k = (r.spec.method.clone(), r.spec.mesh.clone(), r.spec.layer, r.spec.rock);
+        if !keys.contains(&k) {
+            keys.push(k);
         }
-        for (method, mesh, layer, rock) in keys {
-            let same = |s: &WedgeRunSpec, rk: RockModel| s.rock == rk && s.law == main_law && s.beta == main_beta && s.e_factor == 1.0;
-            let name = if method == "nts" { format!("NTS-L{layer}") } else { method.to_uppercase() };
-            c.series.push(Series::line_markers(format!("{name}, {mesh} mesh, {}", rock.describe()), pts(&method, &mesh, layer, &|s| same(s, rock))));
-            c.series.push(Series::line_markers(format!("{name}, {mesh} mesh, {}", main_rock.describe()), pts(&method, &mesh, layer, &|s| same(s, main_rock))));
-        }
-        charts.push(c.write_png_svg(&charts_dir.join("slip_vs_pga_rock"))?.png);
     }
+    for (method, mesh, layer, rock) in keys {
+        let same = |s: &WedgeRunSpec, rk: RockModel| s.rock == rk && s.law == ctx.main_law && s.beta == ctx.main_beta && s.e_factor == 1.0;
+        let name = if method == "nts" { format!("NTS-L{layer}") } else { method.to_uppercase() };
+        c.series.push(Series::line_markers(format!("{name}, {mesh} mesh, {}", rock.describe()), ctx.pts(&method, &mesh, layer, &|s| same(s, rock))));
+        c.series.push(Series::line_markers(format!("{name}, {mesh} mesh, {}", ctx.main_rock.describe()), ctx.pts(&method, &mesh, layer, &|s| same(s, ctx.main_rock))));
+    }
+    Ok(Some(c.write_png_svg(&ctx.charts_dir.join("slip_vs_pga_rock"))?.png))
+}
 
-    // ---- chart: slip history at the accuracy PGA
-    let nts_acc = run_of(&|s| plain(s) && s.pga == acc && s.method == "nts" && s.mesh == sweep && s.layer == 1);
-    let ntn_acc = run_of(&|s| plain(s) && s.pga == acc && s.method == "ntn" && s.mesh == sweep);
-    let ref_acc = run_of(&|s| is_ref(s) && s.pga == acc);
-    let mut c = Chart::new(format!("Slip history at P2, PGA {acc} g — {}", main_law.describe()), "t [s]", "slip along the line of intersection [m]");
-    for (r, name) in [(nts_acc, format!("NTS-L1, {sweep}")), (ntn_acc, format!("NTN, {sweep}")), (ref_acc, format!("reference NTS-L{}, {reference}", prm.reference.layer))] {
+/// Chart: slip history at the accuracy PGA, the headline's levels and the rigid block.
+fn chart_slip_history(ctx: &Ctx<'_>, at: &AtAcc<'_>) -> Result<PathBuf, Error> {
+    let (acc, sweep, reference) = (ctx.acc, &ctx.sweep, &ctx.reference);
+    let mut c = Chart::new(format!("Slip history at P2, PGA {acc} g — {}", ctx.main_law.describe()), "t [s]", "slip along the line of intersection [m]");
+    for (r, name) in [(at.nts, format!("NTS-L1, {sweep}")), (at.ntn, format!("NTN, {sweep}")), (at.reference, format!("reference NTS-L{}, {reference}", ctx.prm.reference.layer))] {
         if let Some(r) = r {
             c.series.push(Series::line(name, r.slip_history.clone()));
         }
     }
-    let ra = rigid_of(acc);
+    let ra = ctx.rigid_of(acc);
     for (bond, name) in [(Bond::Kept, "rigid block, cohesion kept"), (Bond::Brittle, "rigid block, cohesion lost at first slide")] {
         let rb = ra.of_bond(bond);
         if let Some(h) = &rb.result.history {
             c.series.push(Series::line(name, sampled_history(h, rb.dt)));
         }
     }
-    charts.push(c.write_png_svg(&charts_dir.join("slip_history"))?.png);
+    Ok(c.write_png_svg(&ctx.charts_dir.join("slip_history"))?.png)
+}
 
-    // ---- chart: P1 displacement at the accuracy PGA
-    let mut c = Chart::new(format!("Displacement of P1 (wedge, slope face), PGA {acc} g"), "t [s]", "displacement [m]");
-    for (r, tag) in [(nts_acc, "NTS"), (ntn_acc, "NTN")] {
+/// Chart: P1 displacement at the accuracy PGA, NTS and NTN.
+fn chart_p1_history(ctx: &Ctx<'_>, at: &AtAcc<'_>) -> Result<PathBuf, Error> {
+    let mut c = Chart::new(format!("Displacement of P1 (wedge, slope face), PGA {} g", ctx.acc), "t [s]", "displacement [m]");
+    for (r, tag) in [(at.nts, "NTS"), (at.ntn, "NTN")] {
         if let Some(r) = r {
             for (k, axis) in ["x (east)", "y (north)", "z (up)"].iter().enumerate() {
                 c.series.push(Series::line(format!("{tag} {axis}"), r.p1_history.iter().map(|(t, u)| (*t, u[k])).collect::<Vec<_>>()));
             }
         }
     }
-    charts.push(c.write_png_svg(&charts_dir.join("p1_history"))?.png);
+    Ok(c.write_png_svg(&ctx.charts_dir.join("p1_history"))?.png)
+}
 
-    // ---- speed against accuracy at the accuracy PGA (headline runs)
-    let ref_slip = ref_acc.map(|r| r.residual_slip).unwrap_or(f64::NAN);
-    let rigid_acc = ra.bond(main_law);
+/// The levels' cost and error at the accuracy PGA (headline runs), the rigid block first.
+fn speed_accuracy(ctx: &Ctx<'_>, at: &AtAcc<'_>) -> SpeedAccuracy {
+    let acc = ctx.acc;
+    let ref_slip = at.reference.map(|r| r.residual_slip).unwrap_or(f64::NAN);
+    let ra = ctx.rigid_of(acc);
+    let rigid_acc = ra.bond(ctx.main_law);
     let mut sa: Vec<(String, f64, f64, f64)> = Vec::new(); // (level, wall, slip, error)
     sa.push(("rigid block".into(), ra.wall_time.max(1e-4), rigid_acc.result.residual_displacement, (rigid_acc.result.residual_displacement - ref_slip).abs() / ref_slip.abs()));
-    for r in runs.iter().filter(|r| plain(&r.spec) && r.spec.pga == acc && !is_ref(&r.spec) && r.failed.is_none()) {
+    for r in ctx.runs.iter().filter(|r| ctx.plain(&r.spec) && r.spec.pga == acc && !ctx.is_ref(&r.spec) && r.failed.is_none()) {
         let Some(wall) = r.wall_time else { continue };
         sa.push((r.level.clone(), wall, r.residual_slip, (r.residual_slip - ref_slip).abs() / ref_slip.abs()));
     }
     let pts_sa: Vec<(f64, f64)> = sa.iter().map(|x| (x.1, x.3.max(1e-4))).collect();
     let front = pareto_front(&pts_sa);
-    let mut c = Chart::new(format!("Speed against accuracy, PGA {acc} g (reference: NTS-L{} {reference})", prm.reference.layer), "wall time, one thread [s]", "|slip − reference| / reference [-]");
+    SpeedAccuracy { levels: sa, front }
+}
+
+/// Chart: speed against accuracy at the accuracy PGA, with the Pareto front.
+fn chart_speed_accuracy(ctx: &Ctx<'_>, sa: &SpeedAccuracy) -> Result<PathBuf, Error> {
+    let pts_sa: Vec<(f64, f64)> = sa.levels.iter().map(|x| (x.1, x.3.max(1e-4))).collect();
+    let mut c = Chart::new(format!("Speed against accuracy, PGA {} g (reference: NTS-L{} {})", ctx.acc, ctx.prm.reference.layer, ctx.reference), "wall time, one thread [s]", "|slip − reference| / reference [-]");
     c.x_axis = Axis::Log;
     c.y_axis = Axis::Log;
-    c.series.push(Series::markers("model levels", pts_sa.clone()).with_labels(sa.iter().map(|x| x.0.clone())));
-    c.series.push(Series::line_markers("Pareto front", front.iter().map(|&i| pts_sa[i])));
-    charts.push(c.write_png_svg(&charts_dir.join("speed_accuracy"))?.png);
+    c.series.push(Series::markers("model levels", pts_sa.clone()).with_labels(sa.levels.iter().map(|x| x.0.clone())));
+    c.series.push(Series::line_markers("Pareto front", sa.front.iter().map(|&i| pts_sa[i])));
+    Ok(c.write_png_svg(&ctx.charts_dir.join("speed_accuracy"))?.png)
+}
 
-    // ---- strength reduction chart
-    if let Some(s) = &ssr {
-        let mut t: Vec<(f64, f64)> = s.result.trials.iter().map(|t| (t.factor, t.monitor_displacement.max(1e-9))).collect();
-        t.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut c = Chart::new("Strength reduction: displacement of P1 against F", "strength reduction factor F [-]", "|u| of P1 after relaxation [m]");
-        c.y_axis = Axis::Log;
-        c.series.push(Series::line_markers(format!("FEM ({} mesh)", s.mesh), t));
-        charts.push(c.write_png_svg(&charts_dir.join("ssr"))?.png);
-    }
+/// Chart: the strength reduction's trials, displacement of P1 against F (none without it).
+fn chart_ssr(ctx: &Ctx<'_>, ssr: Option<&StudySsr>) -> Result<Option<PathBuf>, Error> {
+    let Some(s) = ssr else { return Ok(None) };
+    let mut t: Vec<(f64, f64)> = s.result.trials.iter().map(|t| (t.factor, t.monitor_displacement.max(1e-9))).collect();
+    t.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut c = Chart::new("Strength reduction: displacement of P1 against F", "strength reduction factor F [-]", "|u| of P1 after relaxation [m]");
+    c.y_axis = Axis::Log;
+    c.series.push(Series::line_markers(format!("FEM ({} mesh)", s.mesh), t));
+    Ok(Some(c.write_png_svg(&ctx.charts_dir.join("ssr"))?.png))
+}
 
-    // ---- cheapest level per PGA (where the reference ran)
+// ---- numbers of the text ----------------------------------------------------------------------
+
+/// The cheapest level per PGA (where the reference ran) whose slip is within `enough` of the
+/// reference's: (PGA, level, wall time, slip).
+fn cheapest_levels(ctx: &Ctx<'_>) -> Vec<(f64, String, f64, f64)> {
     let mut cheapest = Vec::new();
-    for &p in &pgas {
-        let Some(r) = find(&runs, |s| is_ref(s) && s.pga == p) else { continue };
+    for &p in &ctx.pgas {
+        let Some(r) = find(&ctx.runs, |s| ctx.is_ref(s) && s.pga == p) else { continue };
         if r.failed.is_some() {
             cheapest.push((p, "none: the reference run failed".to_string(), f64::NAN, f64::NAN));
             continue;
         }
         let refv = r.residual_slip;
-        let rg = rigid_of(p);
-        let mut cands: Vec<(String, f64, f64)> = vec![("rigid block".into(), rg.wall_time, rg.bond(main_law).result.residual_displacement)];
-        for x in runs.iter().filter(|x| plain(&x.spec) && x.spec.pga == p && !is_ref(&x.spec) && x.failed.is_none()) {
+        let rg = ctx.rigid_of(p);
+        let mut cands: Vec<(String, f64, f64)> = vec![("rigid block".into(), rg.wall_time, rg.bond(ctx.main_law).result.residual_displacement)];
+        for x in ctx.runs.iter().filter(|x| ctx.plain(&x.spec) && x.spec.pga == p && !ctx.is_ref(&x.spec) && x.failed.is_none()) {
             if let Some(wall) = x.wall_time {
                 cands.push((x.level.clone(), wall, x.residual_slip));
             }
@@ -720,112 +920,127 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
             cands.push((r.level.clone() + " (reference)", wall, refv));
         }
         cands.sort_by(|a, b| a.1.total_cmp(&b.1));
-        let tol = prm.enough * refv.abs().max(0.01);
+        let tol = ctx.prm.enough * refv.abs().max(0.01);
         if let Some(c) = cands.iter().find(|c| (c.2 - refv).abs() <= tol) {
             cheapest.push((p, c.0.clone(), c.1, c.2));
         }
     }
+    cheapest
+}
 
-    // ---- trend of NTS against NTN, for the headline and the variant
+/// The trend of NTS against NTN, for the headline and the variant.
+fn trends(ctx: &Ctx<'_>, cv: &Curves) -> Vec<String> {
     let mut trend = Vec::new();
-    let variant_label = other_law.map(|l| format!("variant ({})", l.describe()));
-    for (label, nts, ntn) in [(Some(format!("headline ({})", main_law.describe())), &nts_sweep, &ntn_sweep), (variant_label, &nts_var, &ntn_var)] {
+    let variant_label = ctx.other_law.map(|l| format!("variant ({})", l.describe()));
+    for (label, nts, ntn) in [(Some(format!("headline ({})", ctx.main_law.describe())), &cv.nts_sweep, &cv.ntn_sweep), (variant_label, &cv.nts_var, &cv.ntn_var)] {
         let Some(label) = label else { continue };
-        trend.extend(nts_ntn_trend(&label, &pgas, nts, ntn));
+        trend.extend(nts_ntn_trend(&label, &ctx.pgas, nts, ntn));
     }
+    trend
+}
 
-    // ---- the seed's claims against the headline runs
+/// The seed's claims against the headline runs.
+fn seed_claims(ctx: &Ctx<'_>, cv: &Curves, at: &AtAcc<'_>) -> Vec<SeedClaim> {
+    let mut claims = slip_claims(&ctx.pgas, &cv.nts_sweep, &cv.ntn_sweep);
+    let acc = ctx.acc;
+    for (r, tag, s) in [(at.nts, "NTS", seed::P1_NTS_1G), (at.ntn, "NTN", seed::P1_NTN_1G)] {
+        if let Some(r) = r.filter(|_| acc == seed::PGA) {
+            let ang = angle_deg(r.p1_residual, s);
+            let ratio = (r.p1_residual.iter().map(|x| x * x).sum::<f64>() / s.iter().map(|x| x * x).sum::<f64>()).sqrt();
+            claims.push(SeedClaim {
+                claim: format!("P1 residual displacement at {} g, {tag}", seed::PGA),
+                seed: cm3(s),
+                ours: format!("{}: {}° from the seed's direction, {} × its length", cm3(r.p1_residual), fmt_sig(ang, 2), fmt_sig(ratio, 3)),
+                reproduced: Some(ang <= 15.0 && (ratio - 1.0).abs() <= 0.5),
+            });
+        }
+    }
+    if let Some(r) = at.nts.filter(|_| acc == seed::PGA) {
+        claims.push(SeedClaim {
+            claim: format!("the wedge starts to slide at about {} s and is at rest when the shaking ends ({} g)", seed::ONSET_1G, seed::PGA),
+            seed: format!("{} s; at rest", seed::ONSET_1G),
+            ours: format!("slip exceeds 1 mm at {} s (NTS); {}", r.onset.map(|t| fmt_sig(t, 3)).unwrap_or_else(|| "never".into()), if r.still_sliding { "still sliding at the end" } else { "at rest at the end" }),
+            reproduced: None,
+        });
+        claims.push(SeedClaim {
+            claim: "failure mode: sliding along the line of intersection on both planes, the same for NTS and NTN".into(),
+            seed: "stated (figure 8)".into(),
+            ours: format!("NTS: {}; NTN: {}", r.mode, at.ntn.map(|x| x.mode.as_str()).unwrap_or("–")),
+            reproduced: Some(r.mode.starts_with("sliding on both planes") && at.ntn.is_none_or(|x| x.mode.starts_with("sliding on both planes"))),
+        });
+    }
+    claims
+}
+
+/// The seed's claims on the residual slip against PGA (NTS and NTN on the sweep mesh): no
+/// sliding at low PGA, the values at 1 g, NTS above NTN and the growth of the difference.
+fn slip_claims(pgas: &[f64], nts_sweep: &[(f64, f64)], ntn_sweep: &[(f64, f64)]) -> Vec<SeedClaim> {
     let mut claims = Vec::new();
-    {
-        let low: Vec<(f64, f64)> = pgas
-            .iter()
-            .filter(|&&p| p <= seed::NO_SLIDING_UP_TO)
-            .filter_map(|&p| {
-                let a = nts_sweep.iter().chain(&ntn_sweep).filter(|x| x.0 == p).map(|x| x.1).fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))?;
-                Some((p, a))
-            })
-            .collect();
-        if !low.is_empty() {
-            let ok = low.iter().all(|x| x.1 < 0.01);
-            claims.push(SeedClaim {
-                claim: format!("no obvious sliding at {} g and below", seed::NO_SLIDING_UP_TO),
-                seed: "stated (figure 11)".into(),
-                ours: low.iter().map(|(p, s)| format!("largest NTS/NTN slip {} m at {p} g", m(*s))).collect::<Vec<_>>().join("; "),
-                reproduced: Some(ok),
-            });
-        }
-        let at = |v: &[(f64, f64)]| v.iter().find(|x| x.0 == seed::PGA).map(|x| x.1);
-        if let (Some(a), Some(b)) = (at(&nts_sweep), at(&ntn_sweep)) {
-            claims.push(SeedClaim {
-                claim: format!("residual slip at {} g, NTS / NTN", seed::PGA),
-                seed: format!("{} / {} m", seed::SLIP_NTS_1G, seed::SLIP_NTN_1G),
-                ours: format!("{} / {} m ({} / {} of the seed's)", m(a), m(b), fmt_sig(a / seed::SLIP_NTS_1G, 3), fmt_sig(b / seed::SLIP_NTN_1G, 3)),
-                reproduced: Some((a / seed::SLIP_NTS_1G - 1.0).abs() <= 0.5 && (b / seed::SLIP_NTN_1G - 1.0).abs() <= 0.5),
-            });
-            let d = (a - b) / b;
-            let ds = (seed::SLIP_NTS_1G - seed::SLIP_NTN_1G) / seed::SLIP_NTN_1G;
-            claims.push(SeedClaim {
-                claim: format!("NTS slides more than NTN at {} g", seed::PGA),
-                seed: fmt_percent(ds, 1),
-                ours: fmt_percent(d, 1),
-                reproduced: Some(d > 0.0),
-            });
-        }
-        let sliding: Vec<(f64, f64, f64)> = pgas
-            .iter()
-            .filter_map(|&p| {
-                let a = nts_sweep.iter().find(|x| x.0 == p)?.1;
-                let b = ntn_sweep.iter().find(|x| x.0 == p)?.1;
-                Some((p, a, b))
-            })
-            .filter(|x| x.1.max(x.2) >= 0.01)
-            .collect();
-        if sliding.len() >= 2 {
-            let diffs: Vec<f64> = sliding.iter().map(|x| (x.1 - x.2) / x.2.max(1e-12)).collect();
-            claims.push(SeedClaim {
-                claim: "NTS above NTN at every PGA that slides, the difference growing with PGA".into(),
-                seed: "stated (figure 11)".into(),
-                ours: sliding.iter().zip(&diffs).map(|(x, d)| format!("{} g {}", x.0, fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
-                reproduced: Some(diffs.iter().all(|&d| d > 0.0) && diffs.windows(2).all(|w| w[1] >= w[0])),
-            });
-        }
-        for (r, tag, s) in [(nts_acc, "NTS", seed::P1_NTS_1G), (ntn_acc, "NTN", seed::P1_NTN_1G)] {
-            if let Some(r) = r.filter(|_| acc == seed::PGA) {
-                let ang = angle_deg(r.p1_residual, s);
-                let ratio = (r.p1_residual.iter().map(|x| x * x).sum::<f64>() / s.iter().map(|x| x * x).sum::<f64>()).sqrt();
-                claims.push(SeedClaim {
-                    claim: format!("P1 residual displacement at {} g, {tag}", seed::PGA),
-                    seed: cm3(s),
-                    ours: format!("{}: {}° from the seed's direction, {} × its length", cm3(r.p1_residual), fmt_sig(ang, 2), fmt_sig(ratio, 3)),
-                    reproduced: Some(ang <= 15.0 && (ratio - 1.0).abs() <= 0.5),
-                });
-            }
-        }
-        if let Some(r) = nts_acc.filter(|_| acc == seed::PGA) {
-            claims.push(SeedClaim {
-                claim: format!("the wedge starts to slide at about {} s and is at rest when the shaking ends ({} g)", seed::ONSET_1G, seed::PGA),
-                seed: format!("{} s; at rest", seed::ONSET_1G),
-                ours: format!("slip exceeds 1 mm at {} s (NTS); {}", r.onset.map(|t| fmt_sig(t, 3)).unwrap_or_else(|| "never".into()), if r.still_sliding { "still sliding at the end" } else { "at rest at the end" }),
-                reproduced: None,
-            });
-            claims.push(SeedClaim {
-                claim: "failure mode: sliding along the line of intersection on both planes, the same for NTS and NTN".into(),
-                seed: "stated (figure 8)".into(),
-                ours: format!("NTS: {}; NTN: {}", r.mode, ntn_acc.map(|x| x.mode.as_str()).unwrap_or("–")),
-                reproduced: Some(r.mode.starts_with("sliding on both planes") && ntn_acc.is_none_or(|x| x.mode.starts_with("sliding on both planes"))),
-            });
-        }
+    let low: Vec<(f64, f64)> = pgas
+        .iter()
+        .filter(|&&p| p <= seed::NO_SLIDING_UP_TO)
+        .filter_map(|&p| {
+            let a = nts_sweep.iter().chain(ntn_sweep).filter(|x| x.0 == p).map(|x| x.1).fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))?;
+            Some((p, a))
+        })
+        .collect();
+    if !low.is_empty() {
+        let ok = low.iter().all(|x| x.1 < 0.01);
+        claims.push(SeedClaim {
+            claim: format!("no obvious sliding at {} g and below", seed::NO_SLIDING_UP_TO),
+            seed: "stated (figure 11)".into(),
+            ours: low.iter().map(|(p, s)| format!("largest NTS/NTN slip {} m at {p} g", m(*s))).collect::<Vec<_>>().join("; "),
+            reproduced: Some(ok),
+        });
     }
+    let at = |v: &[(f64, f64)]| v.iter().find(|x| x.0 == seed::PGA).map(|x| x.1);
+    if let (Some(a), Some(b)) = (at(nts_sweep), at(ntn_sweep)) {
+        claims.push(SeedClaim {
+            claim: format!("residual slip at {} g, NTS / NTN", seed::PGA),
+            seed: format!("{} / {} m", seed::SLIP_NTS_1G, seed::SLIP_NTN_1G),
+            ours: format!("{} / {} m ({} / {} of the seed's)", m(a), m(b), fmt_sig(a / seed::SLIP_NTS_1G, 3), fmt_sig(b / seed::SLIP_NTN_1G, 3)),
+            reproduced: Some((a / seed::SLIP_NTS_1G - 1.0).abs() <= 0.5 && (b / seed::SLIP_NTN_1G - 1.0).abs() <= 0.5),
+        });
+        let d = (a - b) / b;
+        let ds = (seed::SLIP_NTS_1G - seed::SLIP_NTN_1G) / seed::SLIP_NTN_1G;
+        claims.push(SeedClaim { claim: format!("NTS slides more than NTN at {} g", seed::PGA), seed: fmt_percent(ds, 1), ours: fmt_percent(d, 1), reproduced: Some(d > 0.0) });
+    }
+    let sliding: Vec<(f64, f64, f64)> = pgas
+        .iter()
+        .filter_map(|&p| {
+            let a = nts_sweep.iter().find(|x| x.0 == p)?.1;
+            let b = ntn_sweep.iter().find(|x| x.0 == p)?.1;
+            Some((p, a, b))
+        })
+        .filter(|x| x.1.max(x.2) >= 0.01)
+        .collect();
+    if sliding.len() >= 2 {
+        let diffs: Vec<f64> = sliding.iter().map(|x| (x.1 - x.2) / x.2.max(1e-12)).collect();
+        claims.push(SeedClaim {
+            claim: "NTS above NTN at every PGA that slides, the difference growing with PGA".into(),
+            seed: "stated (figure 11)".into(),
+            ours: sliding.iter().zip(&diffs).map(|(x, d)| format!("{} g {}", x.0, fmt_percent(*d, 1))).collect::<Vec<_>>().join(", "),
+            reproduced: Some(diffs.iter().all(|&d| d > 0.0) && diffs.windows(2).all(|w| w[1] >= w[0])),
+        });
+    }
+    claims
+}
 
-    // ---- report.md
-    let mut md = String::new();
+// ---- report.md, section by section -------------------------------------------------------------
+
+/// Section: the title and "Model" (geometry, materials, joints, gravity, rock, base motion,
+/// damping).
+fn section_model(md: &mut String, ctx: &Ctx<'_>) {
+    let (prm, base, main_rock) = (ctx.prm, ctx.base, ctx.main_rock);
     let _ = writeln!(md, "# Wedge study: the Hoek & Bray wedge (seed paper, section 4)\n");
-    let _ = writeln!(md, "Generated by `jointquake study report` from `{}`. Units SI; slip and displacements in m.\n", results.plan.study.display());
+    let _ = writeln!(md, "Generated by `jointquake study report` from `{}`. Units SI; slip and displacements in m.\n", ctx.results.plan.study.display());
     let _ = writeln!(md, "## Model\n");
     let mat = base.materials.iter().map(|mm| format!("`{}` E = {} GPa, ν = {}, ρ = {} kg/m³", mm.group, mm.e / 1e9, mm.nu, mm.rho)).collect::<Vec<_>>().join("; ");
     let w = &prm.wedge;
     let plane = |p: &crate::rigid::wedge::PlaneOrientation| format!("{}/{}", p.dip, p.dip_direction);
-    let levels = study
+    let levels = ctx
+        .results
+        .study
         .axis(&prm.mesh_axis)
         .map(|a| a.values.iter().map(|l| format!("{} ({})", l.label, l.variation.set.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", "))).collect::<Vec<_>>().join("; "))
         .unwrap_or_default();
@@ -854,15 +1069,10 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         })
         .collect::<Vec<_>>()
         .join("; ");
-    let _ = writeln!(md, "- Joints: {strength} (seed table 1). Headline: {}{}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).", main_law.describe(), other_law.map(|l| format!("; variant: {}", l.describe())).unwrap_or_default());
+    let _ = writeln!(md, "- Joints: {strength} (seed table 1). Headline: {}{}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).", ctx.main_law.describe(), ctx.other_law.map(|l| format!("; variant: {}", l.describe())).unwrap_or_default());
     let grav = base.loads.gravity.as_ref().and_then(|g| g.groups.clone()).map(|g| g.join(", ")).unwrap_or_else(|| "all".into());
     let _ = writeln!(md, "- Gravity on: {grav} (the rock is a weightless support, as in limit equilibrium); brought to equilibrium before the record.");
-    let others: Vec<RockModel> = other_rock.iter().fold(Vec::new(), |mut v, r| {
-        if !v.contains(&r.spec.rock) {
-            v.push(r.spec.rock);
-        }
-        v
-    });
+    let others = ctx.other_rocks();
     let _ = writeln!(
         md,
         "- Rock of the main runs: {}{}.{}",
@@ -873,7 +1083,11 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     let recs = base.loads.base.iter().map(|b| format!("`{}` along ({}, {}, {}) × {}", b.record.as_ref().and_then(|r| r.file_name()).map(|f| f.to_string_lossy().into_owned()).unwrap_or_else(|| b.synth.as_ref().map(|s| format!("synth seed {} {}", s.seed, s.component)).unwrap_or_default()), b.direction[0], b.direction[1], b.direction[2], b.pga.map(|p| format!("PGA {p} g")).or(b.scale.map(|s| format!("scale {s}"))).unwrap_or_else(|| "1".into()))).collect::<Vec<_>>().join("; ");
     let _ = writeln!(md, "- Base motion (base scene): {recs}. Every record is scaled by one factor so that the horizontal PGA takes the study values: by default the committed El Centro 1940 NS record horizontally (y, north) and 2/3 of the same record vertically (z), in phase. The seed used the Koyna record, which is not public.");
     let _ = writeln!(md, "- Damping: {}. Duration {} s per run (record plus free vibration).\n", damping_text(base), base.time.duration);
+}
 
+/// Section: "Static factor of safety" (limit equilibrium, FEM strength reduction, the seed's
+/// factors) and the pseudo-static critical acceleration.
+fn section_static_fs(md: &mut String, le: &LeTable, ssr: Option<&StudySsr>) {
     let _ = writeln!(md, "## Static factor of safety\n");
     let mut t = Table::new(["method", "geometry (what H = 39.624 m measures)", "FS"]);
     let _ = t.push_row(["limit equilibrium (Hoek & Bray), ours", "vertical rise of the line of intersection", &m(le.fs_intersection)]);
@@ -905,6 +1119,20 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         le.kc_residual.map(m).unwrap_or_else(|| "none".into())
     );
 
+}
+
+/// A value of a slip-against-PGA curve at `p`, or "–".
+fn val(v: &[(f64, f64)], p: f64) -> String {
+    v.iter().find(|x| x.0 == p).map(|x| m(x.1)).unwrap_or_else(|| "–".into())
+}
+
+/// Section: "Seismic runs — headline" (the slip-against-PGA table with the seed's values and
+/// its chart; P1's residual displacement at the accuracy PGA when that is the seed's).
+fn section_headline(md: &mut String, ctx: &Ctx<'_>, cv: &Curves, at: &AtAcc<'_>) {
+    let (prm, sweep, reference, main_law, main_rock, main_beta, acc, pgas): (_, &str, &str, _, _, _, _, _) = (ctx.prm, &ctx.sweep, &ctx.reference, ctx.main_law, ctx.main_rock, ctx.main_beta, ctx.acc, &ctx.pgas);
+    let Curves { nts_sweep, ntn_sweep, nts2_sweep, reference_pts, .. } = cv;
+    let (nts_acc, ntn_acc) = (at.nts, at.ntn);
+    let rigid_main = |p: f64| ctx.rigid_main(p);
     // ---- 1. the headline
     let _ = writeln!(md, "## Seismic runs — headline: {}\n", main_law.describe());
     let _ = writeln!(md, "{}, β = {} s, E as given; residual slip at P2 [m]. The seed's values are from its figures 10–11 and text (Koyna record).\n", main_rock.describe(), fmt_sig(main_beta, 3));
@@ -919,8 +1147,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     }
     head.extend([format!("rigid block ({})", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost" }), "(NTS − NTN)/NTN".into(), "seed NTS / NTN".into()]);
     let mut t = Table::new(head);
-    let val = |v: &[(f64, f64)], p: f64| v.iter().find(|x| x.0 == p).map(|x| m(x.1)).unwrap_or_else(|| "–".into());
-    for &p in &pgas {
+    for &p in pgas {
         let mut row = vec![fmt_sig_short(p), val(&nts_sweep, p), val(&ntn_sweep, p)];
         if has_nts2 {
             row.push(val(&nts2_sweep, p));
@@ -956,9 +1183,13 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         md.push_str(&t.to_markdown());
         let _ = writeln!(md);
     }
+}
+
+/// Section: "The seed's claims" (the table, what "reproduced" means, the NTS − NTN trend).
+fn section_claims(md: &mut String, claims: &[SeedClaim], trend: &[String]) {
     let _ = writeln!(md, "### The seed's claims\n");
     let mut t = Table::new(["claim", "seed", "ours", "reproduced"]);
-    for c in &claims {
+    for c in claims {
         let _ = t.push_row([c.claim.clone(), c.seed.clone(), c.ours.clone(), match c.reproduced {
             Some(true) => "yes".to_string(),
             Some(false) => "no".into(),
@@ -967,41 +1198,56 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     }
     md.push_str(&t.to_markdown());
     let _ = writeln!(md, "\n\"Reproduced\": within 50 % for magnitudes, within 15° for the direction of P1; NTS − NTN as a sign and its growth with PGA. Why the numbers differ (record, duration, damping) is discussed in docs/wedge.md.\n");
-    for s in &trend {
+    for s in trend {
         let _ = writeln!(md, "- {s}");
     }
     let _ = writeln!(md);
 
-    let _ = writeln!(md, "### Headline runs in detail\n");
-    let joint_names = base.joints.iter().map(|j| j.name.as_str()).collect::<Vec<_>>().join(" / ");
-    let detail = |md: &mut String, sel: &dyn Fn(&WedgeRunSpec) -> bool, law: CohesionLaw| {
-        let mut t = Table::new(["PGA [g]".to_string(), "level".into(), "P1 ux".into(), "P1 uy".into(), "P1 uz".into(), "slip at P2".into(), "still sliding".into(), "failure mode".into(), format!("max opening {joint_names}")]);
-        for &p in &pgas {
-            if !runs.iter().any(|r| sel(&r.spec) && r.spec.pga == p && r.spec.mesh == sweep) {
-                continue;
-            }
-            for r in runs.iter().filter(|r| sel(&r.spec) && r.spec.pga == p && r.spec.mesh == sweep) {
-                let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
-                let slip = match &r.failed {
-                    Some(_) => format!("≥ {} (stopped at t = {} s, see below)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))),
-                    None => m(r.residual_slip),
-                };
-                let _ = t.push_row([fmt_sig_short(p), r.level.clone(), m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), r.mode.clone(), op]);
-            }
-            let rg = rigid_of(p).bond(law);
-            let _ = t.push_row([fmt_sig_short(p), format!("rigid block, {}", if law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), "".into(), "".into(), "".into(), m(rg.result.residual_displacement), (if rg.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.result.n_episodes), "".into()]);
-        }
-        md.push_str(&t.to_markdown());
-    };
-    detail(&mut md, &plain, main_law);
-    let _ = writeln!(md, "\n![slip history](charts/slip_history.svg)\n\n![P1 displacement](charts/p1_history.svg)\n");
+}
 
+/// Section: "Headline runs in detail" (every headline run and the rigid block per PGA) and the
+/// history charts.
+fn section_headline_detail(md: &mut String, ctx: &Ctx<'_>) {
+    let _ = writeln!(md, "### Headline runs in detail\n");
+    detail_table(md, ctx, &|s| ctx.plain(s), ctx.main_law);
+    let _ = writeln!(md, "\n![slip history](charts/slip_history.svg)\n\n![P1 displacement](charts/p1_history.svg)\n");
+}
+
+/// The table of the runs `sel` selects on the sweep mesh, PGA by PGA, each PGA closed by the
+/// rigid block with the bond of `law`.
+fn detail_table(md: &mut String, ctx: &Ctx<'_>, sel: &dyn Fn(&WedgeRunSpec) -> bool, law: CohesionLaw) {
+    let joint_names = ctx.joint_names();
+    let mut t = Table::new(["PGA [g]".to_string(), "level".into(), "P1 ux".into(), "P1 uy".into(), "P1 uz".into(), "slip at P2".into(), "still sliding".into(), "failure mode".into(), format!("max opening {joint_names}")]);
+    for &p in &ctx.pgas {
+        if !ctx.runs.iter().any(|r| sel(&r.spec) && r.spec.pga == p && r.spec.mesh == ctx.sweep) {
+            continue;
+        }
+        for r in ctx.runs.iter().filter(|r| sel(&r.spec) && r.spec.pga == p && r.spec.mesh == ctx.sweep) {
+            let op = r.max_opening.iter().map(|(_, v)| m(*v)).collect::<Vec<_>>().join(" / ");
+            let slip = match &r.failed {
+                Some(_) => format!("≥ {} (stopped at t = {} s, see below)", m(r.max_slip), m(r.slip_history.last().map(|x| x.0).unwrap_or(0.0))),
+                None => m(r.residual_slip),
+            };
+            let _ = t.push_row([fmt_sig_short(p), r.level.clone(), m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), r.mode.clone(), op]);
+        }
+        let rg = ctx.rigid_of(p).bond(law);
+        let _ = t.push_row([fmt_sig_short(p), format!("rigid block, {}", if law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), "".into(), "".into(), "".into(), m(rg.result.residual_displacement), (if rg.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.result.n_episodes), "".into()]);
+    }
+    md.push_str(&t.to_markdown());
+}
+
+/// Section: "Variant" (the variant law's slip against PGA, its chart and its runs in detail;
+/// nothing without variant runs).
+fn section_variant(md: &mut String, ctx: &Ctx<'_>, cv: &Curves) {
+    let (sweep, main_rock, main_beta, other_law, pgas): (&str, _, _, _, _) = (&ctx.sweep, ctx.main_rock, ctx.main_beta, ctx.other_law, &ctx.pgas);
+    let Curves { nts_sweep, nts_var, ntn_var, .. } = cv;
+    let rigid_of = |p: f64| ctx.rigid_of(p);
     // ---- 2. the variant law
     if let Some(law) = other_law.filter(|_| !nts_var.is_empty() || !ntn_var.is_empty()) {
         let _ = writeln!(md, "## Variant: {}\n", law.describe());
         let _ = writeln!(md, "The same runs ({}, {sweep} mesh, β = {} s) with the joints' cohesion lost after slip: not the seed's law; residual slip at P2 [m].\n", main_rock.describe(), fmt_sig(main_beta, 3));
         let mut t = Table::new(["PGA [g]".to_string(), format!("NTS-L1 {sweep}"), format!("NTN {sweep}"), "(NTS − NTN)/NTN".into(), "rigid block, cohesion lost at first slide".into(), format!("NTS-L1 {sweep}, headline")]);
-        for &p in pgas.iter().filter(|&&p| nts_var.iter().chain(&ntn_var).any(|x| x.0 == p)) {
+        for &p in pgas.iter().filter(|&&p| nts_var.iter().chain(ntn_var.iter()).any(|x| x.0 == p)) {
             let d = match (nts_var.iter().find(|x| x.0 == p), ntn_var.iter().find(|x| x.0 == p)) {
                 (Some(a), Some(b)) if a.1.max(b.1) >= 0.01 => fmt_percent((a.1 - b.1) / b.1, 1),
                 (Some(_), Some(_)) => "(< 1 cm)".into(),
@@ -1012,10 +1258,22 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         md.push_str(&t.to_markdown());
         let _ = writeln!(md, "\n![slip against PGA, variant](charts/slip_vs_pga_variant.svg)\n");
         let _ = writeln!(md, "### Variant runs in detail\n");
-        detail(&mut md, &variant, law);
+        detail_table(md, ctx, &|s| ctx.variant(s), law);
         let _ = writeln!(md);
     }
 
+}
+
+/// Section: "Rock model" (each run on another rock against its main-rock twin; nothing without
+/// other rock models).
+fn section_rock(md: &mut String, ctx: &Ctx<'_>) {
+    let (prm, main_rock) = (ctx.prm, ctx.main_rock);
+    let other_rock = ctx.other_rock();
+    let others = ctx.other_rocks();
+    let rigid_of = |p: f64| ctx.rigid_of(p);
+    let twin_of = |r: &WedgeRun| {
+        ctx.run_of(&|s: &WedgeRunSpec| s.rock == main_rock && s.pga == r.spec.pga && s.method == r.spec.method && s.layer == r.spec.layer && s.mesh == r.spec.mesh && s.law == r.spec.law && s.e_factor == r.spec.e_factor && s.beta == r.spec.beta)
+    };
     // ---- 3. rock models
     if !other_rock.is_empty() {
         let _ = writeln!(md, "## Rock model: {} against the {}\n", others.iter().map(|r| r.describe()).collect::<Vec<_>>().join(", "), main_rock.describe());
@@ -1037,6 +1295,14 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         let _ = writeln!(md, "\n![slip against PGA, rock models](charts/slip_vs_pga_rock.svg)\n");
     }
 
+}
+
+/// Section: "Stiffness and damping" (E × factor and β variants at the accuracy PGA against the
+/// headline run).
+fn section_stiffness(md: &mut String, ctx: &Ctx<'_>) {
+    let (sweep, main_rock, main_law, main_beta, acc, runs): (&str, _, _, _, _, _) = (&ctx.sweep, ctx.main_rock, ctx.main_law, ctx.main_beta, ctx.acc, &ctx.runs);
+    let plain = |s: &WedgeRunSpec| ctx.plain(s);
+    let run_of = |pred: &dyn Fn(&WedgeRunSpec) -> bool| ctx.run_of(pred);
     // ---- 4. stiffness and damping
     let _ = writeln!(md, "## Stiffness and damping (PGA {acc} g, {sweep} mesh, {})\n", main_rock.describe());
     let mut t = Table::new(["run", "variant", "slip at P2", "same run, headline", "change"]);
@@ -1054,10 +1320,17 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     md.push_str(&t.to_markdown());
     let _ = writeln!(md);
 
+}
+
+/// Section: "Speed against accuracy" (the levels at the accuracy PGA with the Pareto front and
+/// its chart, the cheapest sufficient level per PGA, the strength-reduction chart), then the
+/// runs stopped by their checks.
+fn section_speed_accuracy(md: &mut String, ctx: &Ctx<'_>, sa: &SpeedAccuracy, ref_acc: Option<&WedgeRun>, cheapest: &[(f64, String, f64, f64)], has_ssr: bool) {
+    let (prm, acc, runs) = (ctx.prm, ctx.acc, &ctx.runs);
     let _ = writeln!(md, "## Speed against accuracy (PGA {acc} g, headline)\n");
     let mut t = Table::new(["level", "wall time [s]", "slip [m]", "error vs reference", "Pareto front"]);
-    for (i, x) in sa.iter().enumerate() {
-        let _ = t.push_row([x.0.clone(), m(x.1), m(x.2), fmt_percent(x.3, 1), (if front.contains(&i) { "yes" } else { "" }).into()]);
+    for (i, x) in sa.levels.iter().enumerate() {
+        let _ = t.push_row([x.0.clone(), m(x.1), m(x.2), fmt_percent(x.3, 1), (if sa.front.contains(&i) { "yes" } else { "" }).into()]);
     }
     if let Some(r) = ref_acc {
         let _ = t.push_row([format!("{} (reference)", r.level), opt(r.wall_time), m(r.residual_slip), "0".into(), "".into()]);
@@ -1066,27 +1339,33 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     let _ = writeln!(md, "\n![speed against accuracy](charts/speed_accuracy.svg)\n");
     let _ = writeln!(md, "Cheapest level whose residual slip is within {} of the reference (or of 1 cm when the reference is smaller), at each PGA with a reference run:\n", fmt_percent(prm.enough, 0));
     let mut t = Table::new(["PGA [g]", "cheapest sufficient level", "wall time [s]", "slip [m]"]);
-    for (p, l, w, s) in &cheapest {
+    for (p, l, w, s) in cheapest {
         let num = |x: f64| if x.is_finite() { m(x) } else { "–".to_string() };
         let _ = t.push_row([fmt_sig_short(*p), l.clone(), num(*w), num(*s)]);
     }
     md.push_str(&t.to_markdown());
-    if ssr.is_some() {
+    if has_ssr {
         let _ = writeln!(md, "\n![strength reduction](charts/ssr.svg)\n");
     }
     let stopped: Vec<&WedgeRun> = runs.iter().filter(|r| r.failed.is_some()).collect();
-    if !stopped.is_empty() || !stopped_early.is_empty() {
+    if !stopped.is_empty() || !ctx.stopped_early.is_empty() {
         let _ = writeln!(md, "\nRuns stopped by their checks (the slip they had reached is a lower bound):\n");
         for r in stopped {
             let _ = writeln!(md, "- `{}`: {}", r.spec.id, r.failed.as_deref().unwrap_or("").trim_start_matches("error: "));
         }
-        for (id, f) in &stopped_early {
+        for (id, f) in &ctx.stopped_early {
             let _ = writeln!(md, "- `{id}` (before its first history row): {f}");
         }
     }
+}
+
+/// Section: "Runs" (every run's size, step, cost, slip and lost node-steps) and the total
+/// wall time.
+fn section_runs(md: &mut String, ctx: &Ctx<'_>, ssr: Option<&StudySsr>) {
+    let (runs, joint_names) = (&ctx.runs, ctx.joint_names());
     let _ = writeln!(md, "\n## Runs\n");
     let mut t = Table::new(["run".to_string(), "nodes".into(), "elements".into(), "dt [s]".into(), "steps".into(), "wall time [s]".into(), "slip [m]".into(), format!("lost node-steps {joint_names}")]);
-    for r in &runs {
+    for r in runs {
         let lost = r.lost_node_steps.iter().map(|(_, v)| v.map_or_else(|| "–".to_string(), |v| v.to_string())).collect::<Vec<_>>().join(" / ");
         let slip = if r.failed.is_some() { format!("failed (≥ {})", m(r.max_slip)) } else { m(r.residual_slip) };
         let count = |x: Option<usize>| x.map_or_else(|| "–".to_string(), |x| x.to_string());
@@ -1095,14 +1374,6 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     md.push_str(&t.to_markdown());
     let total: f64 = runs.iter().filter_map(|r| r.wall_time).sum::<f64>() + ssr.as_ref().map_or(0.0, |s| s.wall_time);
     let _ = writeln!(md, "\nSum of the runs' and the strength reduction's wall times (one thread each): {} s.", fmt_sig(total, 4));
-    let mut lines = trend.clone();
-    lines.extend(claims.iter().map(|c| format!("seed: {} — seed {}, ours {} ({})", c.claim, c.seed, c.ours, match c.reproduced {
-        Some(true) => "reproduced",
-        Some(false) => "not reproduced",
-        None => "compare",
-    })));
-    let rep = WedgeReport { le, ssr, runs, rigid, cheapest, trend, claims, headline_law: main_law, headline_beta: main_beta };
-    Ok(KindReport { markdown: md, json: serde_json::to_value(&rep).expect("the report serialises"), charts, lines, unreadable, lists_failed: true })
 }
 
 /// (NTS − NTN)/NTN by PGA and how it compares with the seed's trend.
