@@ -9,7 +9,7 @@ use jointquake::pipeline::RunOptions;
 use jointquake::rigid::wedge::{
     analyse_wedge, critical_horizontal_acceleration, strength_reduction_factor, wedge_fs_report, HeightDef, PlaneOrientation, TensionCrack, WedgeInput, WedgeResult,
 };
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `println!` that ends the process quietly when stdout is closed (`jointquake … | head`): the
 /// standard macro panics on a broken pipe.
@@ -50,28 +50,24 @@ enum Cmd {
     ///
     /// For a scene with `geometry.msh` the file is only read and its groups listed.
     Mesh {
-        /// Scene file (JSON, see docs/scenes.md).
-        scene: PathBuf,
-        /// Mesh cache directory (meshes are keyed by the .geo text and the `set` numbers).
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
+        #[command(flatten)]
+        scene: SceneFile,
+        #[command(flatten)]
+        cache: MeshCache,
     },
     /// Run a scene: gravity equilibrium, dynamic stage, ParaView series, histories, summary.json.
     ///
     /// Scenes with `joints` run with the dynamic contact force (docs/contact.md); `jointquake tag`
     /// checks their joints without running.
     Run {
-        /// Scene file (JSON, see docs/scenes.md).
-        scene: PathBuf,
-        /// Output directory (default: the scene's output.dir, else out/<name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Mesh cache directory.
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
-        /// Threads (default: one below 30 000 elements, else all cores). Results are bit-identical whatever the count.
-        #[arg(long)]
-        threads: Option<usize>,
+        #[command(flatten)]
+        scene: SceneFile,
+        #[command(flatten)]
+        out: OutDir,
+        #[command(flatten)]
+        cache: MeshCache,
+        #[command(flatten)]
+        threads: Threads,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -83,17 +79,15 @@ enum Cmd {
     /// reservoir's added mass included (docs/dam_physics.md). Writes <out>/modes/modes.pvd,
     /// mode_NNN.vtu and modes.json.
     Modes {
-        /// Scene file (JSON, see docs/scenes.md).
-        scene: PathBuf,
+        #[command(flatten)]
+        scene: SceneFile,
         /// Number of modes (lowest first).
         #[arg(short = 'n', long = "count", default_value_t = 6)]
         count: usize,
-        /// Output directory (default: the scene's output.dir, else out/<name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Mesh cache directory.
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
+        #[command(flatten)]
+        out: OutDir,
+        #[command(flatten)]
+        cache: MeshCache,
         /// Print the report as JSON instead of the table.
         #[arg(long)]
         json: bool,
@@ -104,14 +98,12 @@ enum Cmd {
     /// plus the table of crest radial displacements and crown stresses (<out>/static_table.md,
     /// .json). Needs the groups of geo/arch_dam.geo.
     DamStatic {
-        /// Scene file (JSON, see docs/scenes.md).
-        scene: PathBuf,
-        /// Output directory (default: the scene's output.dir, else out/<name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Mesh cache directory.
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
+        #[command(flatten)]
+        scene: SceneFile,
+        #[command(flatten)]
+        out: OutDir,
+        #[command(flatten)]
+        cache: MeshCache,
     },
     /// Tag the joints of a scene (slave/master, normals, Layer1/Layer2, NTN pairs) and write
     /// <out>/tagging/joints.json, one <joint>.vtu per joint and summary.json.
@@ -123,9 +115,8 @@ enum Cmd {
         /// Output directory; files go to <out>/tagging/ (default: the scene's output.dir, else out/<name>).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Mesh cache directory.
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
+        #[command(flatten)]
+        cache: MeshCache,
         /// Print the summary as JSON instead of the table.
         #[arg(long)]
         json: bool,
@@ -172,83 +163,111 @@ enum Cmd {
     /// A generated joint test with its exact reference (patch, slide, impact): writes
     /// <out>/case.msh, scene.json, reference.json; with --run solves it and prints the error
     /// (and writes result.json). Options and defaults: docs/cli.md.
-    Testcase {
-        /// patch (uniform pressure/shear through the joint, static), slide (block on an
-        /// incline), newmark (the block under a base record against rigid Newmark), impact (two bars).
-        kind: String,
-        /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2, mixed:4 (ELEMENT hex8, tet4 or mixed).
-        #[arg(long)]
-        lower: Option<String>,
-        /// Upper side ELEMENT:N[:LAYERS].
-        #[arg(long)]
-        upper: Option<String>,
-        /// Slave side: lower or upper (default the finer side).
-        #[arg(long)]
-        slave: Option<String>,
-        /// Contact method: nts, ntn or penalty.
-        #[arg(long)]
-        method: Option<String>,
-        /// Penalty factor k (kn = k E/h of the slave), with --method penalty.
-        #[arg(long)]
-        penalty: Option<f64>,
-        /// Candidate layer 1 or 2.
-        #[arg(long)]
-        layer: Option<u8>,
-        /// Friction coefficient.
-        #[arg(long)]
-        mu: Option<f64>,
-        /// Bonded joint.
-        #[arg(long)]
-        tied: bool,
-        /// Patch: pressure p [Pa].
-        #[arg(long)]
-        pressure: Option<f64>,
-        /// Patch: shear τ along the joint's x [Pa].
-        #[arg(long, allow_negative_numbers = true)]
-        shear: Option<f64>,
-        /// Joint inclination β [deg] about y.
-        #[arg(long, allow_negative_numbers = true)]
-        inclination: Option<f64>,
-        /// Patch: the lower block massless (condensed).
-        #[arg(long)]
-        massless_lower: bool,
-        /// Slide: simulated time [s].
-        #[arg(long)]
-        duration: Option<f64>,
-        /// Patch: relaxation residual at which the static solve stops.
-        #[arg(long)]
-        residual: Option<f64>,
-        /// Newmark: base record (t [s], a [g]).
-        #[arg(long)]
-        record: Option<PathBuf>,
-        /// Newmark: PGA of the record [g].
-        #[arg(long)]
-        pga: Option<f64>,
-        /// The joint's edge_tolerance (fraction of the master face size).
-        #[arg(long)]
-        edge_tolerance: Option<f64>,
-        /// Shift of the upper side's interior grid lines in the joint plane, as a fraction of
-        /// its element (|s| < 1).
-        #[arg(long, allow_negative_numbers = true)]
-        offset: Option<f64>,
-        /// Turn of the upper side's mesh about the joint normal [deg] (inner half rigid, blended
-        /// to 0 at the outline; |θ| ≤ 45).
-        #[arg(long, allow_negative_numbers = true)]
-        rotate: Option<f64>,
-        /// Patch: a cylindrical joint of radius R [m] (axis along y; R > 0 the lower block
-        /// bulges up, R < 0 a trough; |R| > 0.5); μ must exceed the steepest slope.
-        #[arg(long, allow_negative_numbers = true)]
-        curvature: Option<f64>,
-        /// Output directory.
-        #[arg(long)]
-        out: PathBuf,
-        /// Run the case and print its error against the reference.
-        #[arg(long)]
-        run: bool,
-        /// Print the result as JSON (with --run).
-        #[arg(long)]
-        json: bool,
-    },
+    Testcase(TestcaseArgs),
+}
+
+// `jointquake testcase`: the options of a generated joint test. Serialised with serde into the
+// library's `testcase::CaseSpec` (the study file's form of a case: one parser and one set of
+// checks); `out`, `run` and `json` are the command's own. (No doc comment: the subcommand's
+// help is the `Cmd::Testcase` variant's.)
+#[derive(clap::Args, serde::Serialize)]
+struct TestcaseArgs {
+    /// patch (uniform pressure/shear through the joint, static), slide (block on an
+    /// incline), newmark (the block under a base record against rigid Newmark), impact (two bars).
+    kind: String,
+    /// Lower side ELEMENT:N[:LAYERS], e.g. hex8:4, tet4:3:2, mixed:4 (ELEMENT hex8, tet4 or mixed).
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    lower: Option<String>,
+    /// Upper side ELEMENT:N[:LAYERS].
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    upper: Option<String>,
+    /// Slave side: lower or upper (default the finer side).
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    slave: Option<String>,
+    /// Contact method: nts, ntn or penalty.
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    method: Option<String>,
+    /// Penalty factor k (kn = k E/h of the slave), with --method penalty.
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    penalty: Option<f64>,
+    /// Candidate layer 1 or 2.
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    layer: Option<u8>,
+    /// Friction coefficient.
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mu: Option<f64>,
+    /// Bonded joint.
+    #[arg(long)]
+    tied: bool,
+    /// Patch: pressure p [Pa].
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pressure: Option<f64>,
+    /// Patch: shear τ along the joint's x [Pa].
+    #[arg(long, allow_negative_numbers = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    shear: Option<f64>,
+    /// Joint inclination β [deg] about y.
+    #[arg(long, allow_negative_numbers = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    inclination: Option<f64>,
+    /// Patch: the lower block massless (condensed).
+    #[arg(long)]
+    massless_lower: bool,
+    /// Slide: simulated time [s].
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    duration: Option<f64>,
+    /// Patch: relaxation residual at which the static solve stops.
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    residual: Option<f64>,
+    /// Newmark: base record (t [s], a [g]).
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    record: Option<PathBuf>,
+    /// Newmark: PGA of the record [g].
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pga: Option<f64>,
+    /// The joint's edge_tolerance (fraction of the master face size).
+    #[arg(long)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    edge_tolerance: Option<f64>,
+    /// Shift of the upper side's interior grid lines in the joint plane, as a fraction of
+    /// its element (|s| < 1).
+    #[arg(long, allow_negative_numbers = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    offset: Option<f64>,
+    /// Turn of the upper side's mesh about the joint normal [deg] (inner half rigid, blended
+    /// to 0 at the outline; |θ| ≤ 45).
+    #[arg(long, allow_negative_numbers = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rotate: Option<f64>,
+    /// Patch: a cylindrical joint of radius R [m] (axis along y; R > 0 the lower block
+    /// bulges up, R < 0 a trough; |R| > 0.5); μ must exceed the steepest slope.
+    #[arg(long, allow_negative_numbers = true)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    curvature: Option<f64>,
+    /// Output directory.
+    #[arg(long)]
+    #[serde(skip)]
+    out: PathBuf,
+    /// Run the case and print its error against the reference.
+    #[arg(long)]
+    #[serde(skip)]
+    run: bool,
+    /// Print the result as JSON (with --run).
+    #[arg(long)]
+    #[serde(skip)]
+    json: bool,
 }
 
 /// Ground-motion stages (docs/motion.md).
@@ -329,6 +348,51 @@ enum RecordCmd {
     },
 }
 
+/// The scene file of a command (a positional argument).
+#[derive(clap::Args)]
+struct SceneFile {
+    /// Scene file (JSON, see docs/scenes.md).
+    scene: PathBuf,
+}
+
+/// `--out`: the output directory of a scene command.
+#[derive(clap::Args)]
+struct OutDir {
+    /// Output directory (default: the scene's output.dir, else out/<name>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// `--cache`: where gmsh meshes are cached (one default for every command:
+/// `pipeline::DEFAULT_MESH_CACHE`).
+#[derive(clap::Args)]
+struct MeshCache {
+    /// Mesh cache directory (meshes are keyed by the .geo text and the `set` numbers).
+    #[arg(long = "cache", default_value = jointquake::pipeline::DEFAULT_MESH_CACHE)]
+    cache: PathBuf,
+}
+
+/// `--threads`: the thread count of a command that runs simulations.
+#[derive(clap::Args)]
+struct Threads {
+    /// Threads (default: one below 30 000 elements, else all cores). Results are bit-identical whatever the count.
+    #[arg(long)]
+    threads: Option<usize>,
+}
+
+impl Threads {
+    /// The thread setup, once for every command: `--threads N` within what the machine has
+    /// ([`capped_threads`]) becomes rayon's global pool; the count, or `None` when not given.
+    fn install(&self) -> Result<Option<usize>> {
+        let threads = self.threads.map(capped_threads).transpose()?;
+        if let Some(n) = threads {
+            rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
+        }
+        Ok(threads)
+    }
+}
+
+/// The baseline correction options (`record correct`; every iterate of `synth` and `match`).
 #[derive(clap::Args)]
 struct BaselineArgs {
     /// mean | polynomial | highpass
@@ -380,15 +444,9 @@ struct FitArgs {
     band: Option<String>,
     #[arg(long, default_value_t = 100)]
     max_iterations: usize,
-    /// Baseline correction of every iterate: mean | polynomial | highpass.
-    #[arg(long, default_value = "polynomial")]
-    baseline: String,
-    #[arg(long, default_value_t = 5)]
-    degree: usize,
-    #[arg(long)]
-    corner: Option<f64>,
-    #[arg(long, default_value_t = 4)]
-    order: u32,
+    /// Baseline correction of every iterate (`--baseline` or `--method`).
+    #[command(flatten)]
+    baseline: BaselineArgs,
 }
 
 /// Stages of a study (a study file, docs/studies.md).
@@ -398,8 +456,8 @@ enum StudyCmd {
     /// directory, and mesh every distinct geometry once.
     Plan {
         study: PathBuf,
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
+        #[command(flatten)]
+        cache: MeshCache,
         /// The jointquake binary the generated Makefile calls.
         #[arg(long, default_value = "target/release/jointquake")]
         bin: String,
@@ -410,10 +468,10 @@ enum StudyCmd {
         study: PathBuf,
         /// The step's name (the plan lists the study's steps).
         name: String,
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
-        #[arg(long)]
-        threads: Option<usize>,
+        #[command(flatten)]
+        cache: MeshCache,
+        #[command(flatten)]
+        threads: Threads,
     },
     /// Plan the study (as `plan`) and submit its runs to Slurm: a job array (one task per run
     /// not done yet) and a report job after it (docs/cluster.md).
@@ -437,8 +495,8 @@ enum StudyCmd {
         /// Write the scripts and print the sbatch commands without submitting.
         #[arg(long)]
         dry_run: bool,
-        #[arg(long, default_value = "build/mesh")]
-        cache: PathBuf,
+        #[command(flatten)]
+        cache: MeshCache,
         /// The jointquake binary the tasks run (default: this one; the nodes must see it).
         #[arg(long)]
         bin: Option<PathBuf>,
@@ -511,171 +569,163 @@ fn error_text(e: &anyhow::Error) -> String {
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     match cli.cmd {
-        Cmd::Mesh { scene, cache } => {
-            let s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
-            let mesh = jointquake::pipeline::load_mesh(&s, Some(&cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
-            say!("{}", mesh.source.display());
-            say!("  {} nodes, {} cells", mesh.nodes.len(), mesh.cells.len());
-            for g in &mesh.groups {
-                say!("  group \"{}\" (dim {}): {} cells", g.name, g.dim, g.cells.len());
-            }
-        }
+        Cmd::Mesh { scene, cache } => cmd_mesh(&scene.scene, &cache.cache),
         Cmd::Run { scene, out, cache, threads, quiet, duration } => {
-            let threads = threads.map(capped_threads).transpose()?;
-            if let Some(n) = threads {
-                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
-            }
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: !quiet, duration, threads };
+            let threads = threads.install()?;
+            let opts = RunOptions { out_dir: out.out, mesh_cache: Some(cache.cache), progress: !quiet, duration, threads };
             jointquake::output::recorder::install_interrupt_handler().map_err(anyhow::Error::msg)?;
-            let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
+            let summary = jointquake::pipeline::run(&scene.scene, &opts).with_context(|| format!("running scene {}", scene.scene.display()))?;
             say_raw!("{}", summary.to_text());
             if summary.interrupted.is_some() {
                 std::process::exit(130);
             }
+            Ok(())
         }
-        Cmd::Modes { scene, count, out, cache, json } => {
-            let mut s = jointquake::scene::Scene::load(&scene).with_context(|| format!("loading scene {}", scene.display()))?;
-            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &scene, Some(&cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
-            let out_dir = out.unwrap_or_else(|| s.output_dir());
-            let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
-            let r = jointquake::statics::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;
-            if json {
-                say!("{}", serde_json::to_string_pretty(&r).context("serialising the modes")?);
-            } else {
-                say_raw!("{}", r.to_text());
-            }
-        }
-        Cmd::DamStatic { scene, out, cache } => {
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
-            let mut table_md = None;
-            let mut inspect = |sim: &jointquake::simulation::Simulation<'_>, dir: &std::path::Path| -> Result<(), jointquake::Error> {
-                let t = jointquake::studies::dam::static_table::static_table(&sim.problem.model, &sim.state.u)?;
-                std::fs::create_dir_all(dir).map_err(|e| jointquake::error::OutputError::write(dir, e))?;
-                let md = dir.join("static_table.md");
-                std::fs::write(&md, t.to_markdown()).map_err(|e| jointquake::error::OutputError::write(&md, e))?;
-                let js = dir.join("static_table.json");
-                std::fs::write(&js, serde_json::to_string_pretty(&t).expect("serialises")).map_err(|e| jointquake::error::OutputError::write(&js, e))?;
-                table_md = Some((t.to_markdown(), md));
-                Ok(())
-            };
-            let summary = jointquake::pipeline::run_inspect(&scene, &opts, &mut inspect).with_context(|| format!("static state of scene {}", scene.display()))?;
-            say_raw!("{}", summary.to_text());
-            if let Some((md, path)) = table_md {
-                say!("{md}");
-                say!("static table: {}", path.display());
-            }
-        }
+        Cmd::Modes { scene, count, out, cache, json } => cmd_modes(&scene.scene, count, out.out, &cache.cache, json),
+        Cmd::DamStatic { scene, out, cache } => cmd_dam_static(&scene.scene, out.out, cache.cache),
         Cmd::Tag { scene, out, cache, json } => {
-            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: None, threads: None };
+            let opts = RunOptions { out_dir: out, mesh_cache: Some(cache.cache), progress: false, duration: None, threads: None };
             let summary = jointquake::pipeline::tag(&scene, &opts).with_context(|| format!("tagging the joints of scene {}", scene.display()))?;
             if json {
                 say!("{}", serde_json::to_string_pretty(&summary).context("serialising the tag summary")?);
             } else {
                 say_raw!("{}", summary.to_text());
             }
+            Ok(())
         }
-        Cmd::WedgeFs { input, height_def, h, crack, crack_distance, json } => {
-            let mut w = match &input {
-                Some(p) => {
-                    let text = std::fs::read_to_string(p).with_context(|| format!("reading wedge input {}", p.display()))?;
-                    serde_json::from_str::<WedgeInput>(&text)
-                        .with_context(|| format!("wedge input {}: expected the fields of WedgeInput (see docs/cli.md)", p.display()))?
-                }
-                None => WedgeInput::default(),
-            };
-            if let Some(d) = height_def {
-                w.height_def = match d {
-                    HeightDefArg::Intersection => HeightDef::Intersection,
-                    HeightDefArg::CrestOnA => HeightDef::CrestOnA,
-                };
-            }
-            if let Some(h) = h {
-                w.height = h;
-            }
-            match (crack, crack_distance, w.tension_crack.as_mut()) {
-                (Some(orientation), Some(distance), _) => w.tension_crack = Some(TensionCrack { orientation, distance }),
-                (Some(orientation), None, Some(tc)) => tc.orientation = orientation,
-                (None, Some(distance), Some(tc)) => tc.distance = distance,
-                (Some(_), None, None) => anyhow::bail!("--crack needs --crack-distance L [m] (distance behind the crest along the trace of plane A), or a tension_crack in the --input file"),
-                (None, Some(_), None) => anyhow::bail!("--crack-distance needs --crack DIP/DIPDIR (the crack orientation), or a tension_crack in the --input file"),
-                (None, None, _) => {}
-            }
-            let what = || match &input {
-                Some(p) => format!("wedge of {}", p.display()),
-                None => "seed wedge".to_string(),
-            };
-            if json {
-                let result = analyse_wedge(&w).with_context(|| format!("limit equilibrium of the {}", what()))?;
-                let srf = strength_reduction_factor(&w).with_context(|| format!("strength reduction of the {}", what()))?;
-                let kc = critical_horizontal_acceleration(&w, 0.0).with_context(|| format!("critical acceleration of the {}", what()))?;
-                let out = WedgeFsJson { result, strength_reduction_factor: srf, critical_kh_azimuth_0: kc };
-                say!("{}", serde_json::to_string_pretty(&out).context("serialising the wedge result")?);
-            } else {
-                say_raw!("{}", wedge_fs_report(&w).with_context(|| format!("limit equilibrium of the {}", what()))?);
-            }
+        Cmd::WedgeFs { input, height_def, h, crack, crack_distance, json } => cmd_wedge_fs(input, height_def, h, crack, crack_distance, json),
+        Cmd::Study { action } => study_cmd(action),
+        Cmd::Record { action } => record_cmd(action),
+        Cmd::Testcase(args) => cmd_testcase(args),
+    }
+}
+
+/// `jointquake mesh`: mesh the scene (no pattern expansion: the groups as the mesh has them).
+fn cmd_mesh(scene: &Path, cache: &Path) -> Result<()> {
+    let s = jointquake::scene::Scene::load(scene).with_context(|| format!("loading scene {}", scene.display()))?;
+    let mesh = jointquake::pipeline::load_mesh(&s, Some(cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
+    say!("{}", mesh.source.display());
+    say!("  {} nodes, {} cells", mesh.nodes.len(), mesh.cells.len());
+    for g in &mesh.groups {
+        say!("  group \"{}\" (dim {}): {} cells", g.name, g.dim, g.cells.len());
+    }
+    Ok(())
+}
+
+/// `jointquake modes`: the lowest `count` modes of the scene's model.
+fn cmd_modes(scene: &Path, count: usize, out: Option<PathBuf>, cache: &Path, json: bool) -> Result<()> {
+    let mut s = jointquake::scene::Scene::load(scene).with_context(|| format!("loading scene {}", scene.display()))?;
+    let mesh = jointquake::pipeline::load_scene_mesh(&mut s, scene, Some(cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
+    let out_dir = out.unwrap_or_else(|| s.output_dir());
+    let problem = jointquake::problem::Problem::build(s, mesh).with_context(|| format!("building scene {}", scene.display()))?;
+    let r = jointquake::statics::modes::modes(&problem, count, &out_dir).with_context(|| format!("modes of scene {}", scene.display()))?;
+    if json {
+        say!("{}", serde_json::to_string_pretty(&r).context("serialising the modes")?);
+    } else {
+        say_raw!("{}", r.to_text());
+    }
+    Ok(())
+}
+
+/// `jointquake dam-static`: the scene's static state as a zero-length run, and the dam's static
+/// table written next to it (`studies::dam::static_table::write_static_table`).
+fn cmd_dam_static(scene: &Path, out: Option<PathBuf>, cache: PathBuf) -> Result<()> {
+    let opts = RunOptions { out_dir: out, mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
+    let mut table_md = None;
+    let mut inspect = |sim: &jointquake::simulation::Simulation<'_>, dir: &Path| -> Result<(), jointquake::Error> {
+        let (t, md) = jointquake::studies::dam::static_table::write_static_table(&sim.problem.model, &sim.state.u, dir)?;
+        table_md = Some((t.to_markdown(), md));
+        Ok(())
+    };
+    let summary = jointquake::pipeline::run_inspect(scene, &opts, &mut inspect).with_context(|| format!("static state of scene {}", scene.display()))?;
+    say_raw!("{}", summary.to_text());
+    if let Some((md, path)) = table_md {
+        say!("{md}");
+        say!("static table: {}", path.display());
+    }
+    Ok(())
+}
+
+/// `jointquake wedge-fs`: Hoek & Bray limit equilibrium of the seed wedge or the input's.
+fn cmd_wedge_fs(input: Option<PathBuf>, height_def: Option<HeightDefArg>, h: Option<f64>, crack: Option<PlaneOrientation>, crack_distance: Option<f64>, json: bool) -> Result<()> {
+    let mut w = match &input {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).with_context(|| format!("reading wedge input {}", p.display()))?;
+            serde_json::from_str::<WedgeInput>(&text).with_context(|| format!("wedge input {}: expected the fields of WedgeInput (see docs/cli.md)", p.display()))?
         }
-        Cmd::Study { action } => study_cmd(action)?,
-        Cmd::Record { action } => record_cmd(action)?,
-        Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, offset, rotate, curvature, record, pga, out, run, json } => {
-            // the options as the study file writes a case (one parser and one set of checks)
-            let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
-            let opts: [(&str, serde_json::Value); 18] = [
-                ("curvature", curvature.into()),
-                ("offset", offset.into()),
-                ("rotate", rotate.into()),
-                ("record", record.map(|p| p.display().to_string()).into()),
-                ("pga", pga.into()),
-                ("edge_tolerance", edge_tolerance.into()),
-                ("lower", lower.into()),
-                ("upper", upper.into()),
-                ("slave", slave.into()),
-                ("method", method.into()),
-                ("penalty", penalty.into()),
-                ("layer", layer.into()),
-                ("mu", mu.into()),
-                ("pressure", pressure.into()),
-                ("shear", shear.into()),
-                ("inclination", inclination.into()),
-                ("duration", duration.into()),
-                ("residual", residual.into()),
-            ];
-            for (k, v) in opts {
-                if !v.is_null() {
-                    o[k] = v;
-                }
-            }
-            let spec: jointquake::testcase::CaseSpec = serde_json::from_value(o).context("testcase options (docs/cli.md, `testcase`)")?;
-            let case = jointquake::testcase::build(&spec)?;
-            let files = jointquake::testcase::write_case(&case, &out)?;
-            say!("case      {}", case.spec.label());
-            say!("mesh      {} ({} nodes, {} cells)", files.msh.display(), case.mesh.nodes.len(), case.mesh.cells.len());
-            say!("scene     {}", files.scene.display());
-            say!("reference {}", files.reference.display());
-            if run {
-                let r = jointquake::testcase::run::run_case(&case).with_context(|| format!("running {}", case.spec.label()))?;
-                let p = out.join("result.json");
-                std::fs::write(&p, serde_json::to_string_pretty(&r)?).with_context(|| format!("writing {}", p.display()))?;
-                if json {
-                    say!("{}", serde_json::to_string_pretty(&r)?);
-                } else {
-                    say!("result    {}", p.display());
-                    say!("error     {:.4e} ({}), {} steps, {:.2} s", r.error, r.error_of, r.steps, r.wall_time);
-                    say!("details   {}", serde_json::to_string(&r.errors)?);
-                }
-            }
+        None => WedgeInput::default(),
+    };
+    if let Some(d) = height_def {
+        w.height_def = match d {
+            HeightDefArg::Intersection => HeightDef::Intersection,
+            HeightDefArg::CrestOnA => HeightDef::CrestOnA,
+        };
+    }
+    if let Some(h) = h {
+        w.height = h;
+    }
+    match (crack, crack_distance, w.tension_crack.as_mut()) {
+        (Some(orientation), Some(distance), _) => w.tension_crack = Some(TensionCrack { orientation, distance }),
+        (Some(orientation), None, Some(tc)) => tc.orientation = orientation,
+        (None, Some(distance), Some(tc)) => tc.distance = distance,
+        (Some(_), None, None) => anyhow::bail!("--crack needs --crack-distance L [m] (distance behind the crest along the trace of plane A), or a tension_crack in the --input file"),
+        (None, Some(_), None) => anyhow::bail!("--crack-distance needs --crack DIP/DIPDIR (the crack orientation), or a tension_crack in the --input file"),
+        (None, None, _) => {}
+    }
+    let what = || match &input {
+        Some(p) => format!("wedge of {}", p.display()),
+        None => "seed wedge".to_string(),
+    };
+    if json {
+        let result = analyse_wedge(&w).with_context(|| format!("limit equilibrium of the {}", what()))?;
+        let srf = strength_reduction_factor(&w).with_context(|| format!("strength reduction of the {}", what()))?;
+        let kc = critical_horizontal_acceleration(&w, 0.0).with_context(|| format!("critical acceleration of the {}", what()))?;
+        let out = WedgeFsJson { result, strength_reduction_factor: srf, critical_kh_azimuth_0: kc };
+        say!("{}", serde_json::to_string_pretty(&out).context("serialising the wedge result")?);
+    } else {
+        say_raw!("{}", wedge_fs_report(&w).with_context(|| format!("limit equilibrium of the {}", what()))?);
+    }
+    Ok(())
+}
+
+/// `jointquake testcase`: write the case (and with `--run` solve it and print its error).
+fn cmd_testcase(args: TestcaseArgs) -> Result<()> {
+    // the options as the study file writes a case (one parser and one set of checks)
+    let value = serde_json::to_value(&args).context("testcase options (docs/cli.md, `testcase`)")?;
+    let spec: jointquake::testcase::CaseSpec = serde_json::from_value(value).context("testcase options (docs/cli.md, `testcase`)")?;
+    let case = jointquake::testcase::build(&spec)?;
+    let out = &args.out;
+    let files = jointquake::testcase::write_case(&case, out)?;
+    say!("case      {}", case.spec.label());
+    say!("mesh      {} ({} nodes, {} cells)", files.msh.display(), case.mesh.nodes.len(), case.mesh.cells.len());
+    say!("scene     {}", files.scene.display());
+    say!("reference {}", files.reference.display());
+    if args.run {
+        let r = jointquake::testcase::run::run_case(&case).with_context(|| format!("running {}", case.spec.label()))?;
+        let p = out.join("result.json");
+        std::fs::write(&p, serde_json::to_string_pretty(&r)?).with_context(|| format!("writing {}", p.display()))?;
+        if args.json {
+            say!("{}", serde_json::to_string_pretty(&r)?);
+        } else {
+            say!("result    {}", p.display());
+            say!("error     {:.4e} ({}), {} steps, {:.2} s", r.error, r.error_of, r.steps, r.wall_time);
+            say!("details   {}", serde_json::to_string(&r.errors)?);
         }
     }
     Ok(())
 }
 
-fn baseline_of(method: &str, degree: usize, corner: Option<f64>, order: u32) -> Result<jointquake::motion::Baseline> {
-    use jointquake::motion::Baseline;
-    Ok(match method {
-        "mean" => Baseline::Mean,
-        "polynomial" => Baseline::Polynomial { degree },
-        "highpass" => Baseline::HighPass { corner: corner.context("--method highpass needs --corner F [Hz] (e.g. 0.05)")?, order },
-        other => anyhow::bail!("baseline method \"{other}\": use mean, polynomial or highpass"),
-    })
+impl BaselineArgs {
+    /// The baseline correction these options name.
+    fn baseline(&self) -> Result<jointquake::motion::Baseline> {
+        use jointquake::motion::Baseline;
+        Ok(match self.method.as_str() {
+            "mean" => Baseline::Mean,
+            "polynomial" => Baseline::Polynomial { degree: self.degree },
+            "highpass" => Baseline::HighPass { corner: self.corner.context("--method highpass needs --corner F [Hz] (e.g. 0.05)")?, order: self.order },
+            other => anyhow::bail!("baseline method \"{other}\": use mean, polynomial or highpass"),
+        })
+    }
 }
 
 fn target_of(a: &TargetArgs) -> Result<jointquake::motion::TargetSpec> {
@@ -715,7 +765,7 @@ fn record_cmd(action: RecordCmd) -> Result<()> {
         }
         RecordCmd::Correct { file, baseline, out, g } => {
             let r = Record::read(&file, g).with_context(|| format!("reading record {}", file.display()))?;
-            let m = baseline_of(&baseline.method, baseline.degree, baseline.corner, baseline.order)?;
+            let m = baseline.baseline()?;
             let text = commands::correct_file(&file, r.t0, r.dt, &r.accel, g, &m, &out).with_context(|| format!("correcting {}", file.display()))?;
             say_raw!("{text}");
         }
@@ -737,7 +787,7 @@ fn record_cmd(action: RecordCmd) -> Result<()> {
                 req.band = band_of(b)?;
             }
             req.max_iterations = fit.max_iterations;
-            req.baseline = baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)?;
+            req.baseline = fit.baseline.baseline()?;
             let (text, _) = commands::synth_files(&req, &out, &name).context("synthesising the set")?;
             say_raw!("{text}");
         }
@@ -748,7 +798,7 @@ fn record_cmd(action: RecordCmd) -> Result<()> {
                 Some(b) => band_of(b)?,
                 None => [f64::max(0.04, 4.0 * r.dt), 3.0],
             };
-            let opts = synth::MatchOptions { tolerance: fit.tolerance, band, max_iterations: fit.max_iterations, baseline: baseline_of(&fit.baseline, fit.degree, fit.corner, fit.order)? };
+            let opts = synth::MatchOptions { tolerance: fit.tolerance, band, max_iterations: fit.max_iterations, baseline: fit.baseline.baseline()? };
             let ag: Vec<f64> = r.accel.iter().map(|a| a / g).collect();
             let text = commands::match_file(&file, r.dt, &ag, &t, pga, &opts, &out).with_context(|| format!("matching {}", file.display()))?;
             say_raw!("{text}");
@@ -763,7 +813,7 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
     match action {
         StudyCmd::Plan { study: path, cache, bin } => {
             let (s, kind) = load(&path)?;
-            let files = study::write_plan(&s, &kind.steps(), &cache, &bin).with_context(|| format!("planning study {}", path.display()))?;
+            let files = study::write_plan(&s, &kind.steps(), &cache.cache, &bin).with_context(|| format!("planning study {}", path.display()))?;
             say!(
                 "study {} ({}): {} runs planned ({} scenes new or changed), {} steps, {} meshes ready",
                 s.name,
@@ -782,7 +832,7 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
                 Some(b) => b,
                 None => std::env::current_exe().context("finding this jointquake binary (give --bin)")?,
             };
-            let opts = slurm::SlurmOptions { partition, time, cpus_per_run, max_parallel, bin, cache };
+            let opts = slurm::SlurmOptions { partition, time, cpus_per_run, max_parallel, bin, cache: cache.cache };
             opts.check()?;
             let (s, kind) = load(&path)?;
             study::write_plan(&s, &kind.steps(), &opts.cache, &opts.bin.display().to_string()).with_context(|| format!("planning study {}", path.display()))?;
@@ -809,12 +859,9 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
             }
         }
         StudyCmd::Step { study: path, name, cache, threads } => {
-            let threads = threads.map(capped_threads).transpose()?;
-            if let Some(n) = threads {
-                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("setting the thread count")?;
-            }
+            threads.install()?;
             let (s, kind) = load(&path)?;
-            let opts = study::StepOptions { mesh_cache: cache };
+            let opts = study::StepOptions { mesh_cache: cache.cache };
             let (p, out) = study::run_step(&s, kind.as_ref(), &name, &opts).with_context(|| format!("step {name} of study {}", path.display()))?;
             for l in &out.lines {
                 say!("{l}");

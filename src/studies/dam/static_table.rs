@@ -11,7 +11,8 @@
 //! tangent in its vertical plane (n × arch); stresses are tension positive [Pa]. The quarter
 //! points are the upstream crest nodes nearest x = ±X_e/2, with X_e the crest's half-span.
 
-use crate::error::{Error, ModelError};
+use crate::error::{Error, ModelError, OutputError};
+use std::path::{Path, PathBuf};
 use crate::model::Model;
 use nalgebra::{Matrix3, Vector3};
 use std::collections::HashSet;
@@ -65,6 +66,19 @@ fn face_normals(model: &Model, group: &str) -> Result<Vec<(usize, Vector3<f64>)>
 
 fn horizontal(n: &Vector3<f64>) -> Vector3<f64> {
     Vector3::new(n[0], n[1], 0.0).normalize()
+}
+
+/// The `dam-static` command's table: [`static_table`] of `u`, written as
+/// `<dir>/static_table.md` and `<dir>/static_table.json` (the directory is created). Returns the
+/// table and the Markdown file's path.
+pub fn write_static_table(model: &Model, u: &[f64], dir: &Path) -> Result<(DamStaticTable, PathBuf), Error> {
+    let t = static_table(model, u)?;
+    std::fs::create_dir_all(dir).map_err(|e| OutputError::write(dir, e))?;
+    let md = dir.join("static_table.md");
+    std::fs::write(&md, t.to_markdown()).map_err(|e| OutputError::write(&md, e))?;
+    let js = dir.join("static_table.json");
+    std::fs::write(&js, serde_json::to_string_pretty(&t).expect("the static table serialises")).map_err(|e| OutputError::write(&js, e))?;
+    Ok((t, md))
 }
 
 /// The table of displacement field `u` (3 per node) of the dam model.
