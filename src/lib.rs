@@ -5,11 +5,13 @@
 //! ParaView series, CSV histories and charts.
 //!
 //! ```text
-//! geo/*.geo --gmsh--> .msh --mesh--> Mesh --Problem::build--> Problem {
+//! geo/*.geo --gmsh--> .msh --pipeline::load_scene_mesh--> Mesh (+ the scene's group patterns
+//!   expanded) --Problem::build--> Problem {
 //!     model   (elements, NodalMass: inertia vs weight, supports; built once, immutable)
 //!     joints  (their own stage: tagged once by interface/, laws, frames)
-//!     loads   (gravity, base records, tractions) }
-//!   --Simulation::new(&problem)--> .equilibrate() --> .run(&mut recorder)
+//!     loads   (gravity, base records, tractions, the reservoir's hydrostatic forces) }
+//!   --Simulation::new(&problem)--> .equilibrate() (the one door to the static state: the
+//!       scene's equilibrium.sequence, construction stages in statics/) --> .run(&mut recorder)
 //!       State (t, u[n], u[n−1], energy, contact history) stepped by ExplicitSolver (scratch
 //!       only); after each prediction the step calls its constraints (constraint.rs: contact)
 //!   --Recorder (output/)--> out/<scene>/ frames/*.vtu, <scene>.pvd, joints/, histories/*.csv,
@@ -27,6 +29,8 @@
 //! - masses (inertial vs gravitational, 3×3 inertia blocks, massless nodes): [`model::mass`]; selective mass scaling: [`model::mass_scaling`]
 //! - contact conventions (normal, gap sign, frame, forces): [`contact`]; the contact mobility of
 //!   an anisotropic mass: `docs/contact.md`
+//! - the face-integration kernel (nodal weights of a tri3/quad4 face, for the tagger, the
+//!   tractions and the reservoir): [`interface::face_nodal_weights_into`]
 //! - errors (what the user must fix): [`error`]
 //! - charts (PNG + SVG) and Markdown tables for study reports: [`report`]
 //! - study files, run ids, the results layout: [`study`] (and `docs/studies.md`); what each
@@ -34,7 +38,9 @@
 //!
 //! [`pipeline::run`] is the recipe: the only function that sequences the stages, through the
 //! run object [`simulation::Simulation`], which strength reduction, the tests and the benchmarks
-//! drive too. Module dependencies point down (no import loop): `docs/architecture.md`.
+//! drive too. Every module, its job and what it may import, and the rules written once:
+//! `docs/architecture.md` (a test keeps its module list true); dependencies point down (no
+//! import loop; `make test` checks it).
 
 pub mod constraint;
 pub mod contact;
