@@ -61,11 +61,7 @@ enum Cmd {
     /// checks their joints without running.
     Run {
         #[command(flatten)]
-        scene: SceneFile,
-        #[command(flatten)]
-        out: OutDir,
-        #[command(flatten)]
-        cache: MeshCache,
+        io: SceneOut,
         #[command(flatten)]
         threads: Threads,
         /// No progress bar.
@@ -80,14 +76,10 @@ enum Cmd {
     /// mode_NNN.vtu and modes.json.
     Modes {
         #[command(flatten)]
-        scene: SceneFile,
+        io: SceneOut,
         /// Number of modes (lowest first).
         #[arg(short = 'n', long = "count", default_value_t = 6)]
         count: usize,
-        #[command(flatten)]
-        out: OutDir,
-        #[command(flatten)]
-        cache: MeshCache,
         /// Print the report as JSON instead of the table.
         #[arg(long)]
         json: bool,
@@ -99,11 +91,7 @@ enum Cmd {
     /// .json). Needs the groups of geo/arch_dam.geo.
     DamStatic {
         #[command(flatten)]
-        scene: SceneFile,
-        #[command(flatten)]
-        out: OutDir,
-        #[command(flatten)]
-        cache: MeshCache,
+        io: SceneOut,
     },
     /// Tag the joints of a scene (slave/master, normals, Layer1/Layer2, NTN pairs) and write
     /// <out>/tagging/joints.json, one <joint>.vtu per joint and summary.json.
@@ -363,6 +351,18 @@ struct OutDir {
     out: Option<PathBuf>,
 }
 
+/// The scene a command reads, its output directory and the mesh cache (`run`, `modes`,
+/// `dam-static`).
+#[derive(clap::Args)]
+struct SceneOut {
+    #[command(flatten)]
+    scene: SceneFile,
+    #[command(flatten)]
+    out: OutDir,
+    #[command(flatten)]
+    cache: MeshCache,
+}
+
 /// `--cache`: where gmsh meshes are cached (one default for every command:
 /// `pipeline::DEFAULT_MESH_CACHE`).
 #[derive(clap::Args)]
@@ -570,19 +570,20 @@ fn real_main() -> Result<()> {
     let cli = Cli::parse();
     match cli.cmd {
         Cmd::Mesh { scene, cache } => cmd_mesh(&scene.scene, &cache.cache),
-        Cmd::Run { scene, out, cache, threads, quiet, duration } => {
+        Cmd::Run { io, threads, quiet, duration } => {
             let threads = threads.install()?;
-            let opts = RunOptions { out_dir: out.out, mesh_cache: Some(cache.cache), progress: !quiet, duration, threads };
+            let scene = io.scene.scene;
+            let opts = RunOptions { out_dir: io.out.out, mesh_cache: Some(io.cache.cache), progress: !quiet, duration, threads };
             jointquake::output::recorder::install_interrupt_handler().map_err(anyhow::Error::msg)?;
-            let summary = jointquake::pipeline::run(&scene.scene, &opts).with_context(|| format!("running scene {}", scene.scene.display()))?;
+            let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
             say_raw!("{}", summary.to_text());
             if summary.interrupted.is_some() {
                 std::process::exit(130);
             }
             Ok(())
         }
-        Cmd::Modes { scene, count, out, cache, json } => cmd_modes(&scene.scene, count, out.out, &cache.cache, json),
-        Cmd::DamStatic { scene, out, cache } => cmd_dam_static(&scene.scene, out.out, cache.cache),
+        Cmd::Modes { io, count, json } => cmd_modes(&io.scene.scene, count, io.out.out, &io.cache.cache, json),
+        Cmd::DamStatic { io } => cmd_dam_static(&io.scene.scene, io.out.out, io.cache.cache),
         Cmd::Tag { scene, out, cache, json } => {
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache.cache), progress: false, duration: None, threads: None };
             let summary = jointquake::pipeline::tag(&scene, &opts).with_context(|| format!("tagging the joints of scene {}", scene.display()))?;
