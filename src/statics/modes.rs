@@ -62,6 +62,13 @@ pub struct ModesReport {
 
 /// The `count` lowest modes of `problem`, with the shapes written under `out_dir/modes/`.
 pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesReport, Error> {
+    modes_with(problem, count, out_dir, true)
+}
+
+/// [`modes`], with the `"fe_incompressible"` reservoir's full added mass (`full_fluid_mass`,
+/// what `jointquake modes` uses) or only its lumping (the model's nodal blocks: the mass the
+/// explicit run integrates; to measure what the lumping loses).
+pub fn modes_with(problem: &Problem, count: usize, out_dir: &Path, full_fluid_mass: bool) -> Result<ModesReport, Error> {
     let t0 = std::time::Instant::now();
     if count == 0 {
         return Err(ModelError::Invalid("modes: -n must be at least 1".into()).into());
@@ -81,8 +88,10 @@ pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesRep
     let inertia: Vec<f64> = model.mass.inertial.iter().zip(&model.weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect();
     // the incompressible FE reservoir: its full added mass (the model holds its lumping)
     let mut m_all = mass_matrix(&inertia, &blocks, &all, na);
-    if let Some(extra) = crate::problem::reservoir::coupled_added_mass_of_scene(&model.mesh, &problem.scene)? {
-        m_all = crate::linalg::add_entries(&m_all, &extra);
+    if full_fluid_mass {
+        if let Some(extra) = crate::problem::reservoir::coupled_added_mass_of_scene(&model.mesh, &problem.scene)? {
+            m_all = crate::linalg::add_entries(&m_all, &extra);
+        }
     }
     let mff = t.reduce(&m_all);
     let with_mass = (0..nf).filter(|&j| mff.get(j, j) > 0.0).count();

@@ -5,7 +5,9 @@
 //! `transfer`), a dam acceleration a gives the pressure H p = ρw G a and the forces
 //! f = −Gᵀ p = −M_a a with
 //!
-//!     M_a = ρw Gᵀ H⁻¹ G   [kg], symmetric positive semi-definite, 3 n_wet × 3 n_wet, dense.
+//! ```text
+//! M_a = ρw Gᵀ H⁻¹ G   [kg], symmetric positive semi-definite, 3 n_wet × 3 n_wet, dense.
+//! ```
 //!
 //! H is factorised once (faer sparse Cholesky); only the water's wet unknowns W enter G, so
 //! M_a = ρw G_Wᵀ S G_W with S = (H⁻¹)_WW from n_W solves (blocks of 64 right-hand sides).

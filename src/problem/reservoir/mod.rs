@@ -1,5 +1,15 @@
 //! Reservoir loads on a wet face group (incompressible water): hydrostatic nodal forces and
-//! the Westergaard/Kuo generalised added mass. Pure functions of the mesh and the face group.
+//! the added mass of each `reservoir.model` (module scene::reservoir). Pure functions of the
+//! mesh, the face groups and the scene, evaluated once when the problem is built.
+//!
+//! Owns: the Westergaard/Kuo added mass and the hydrostatic load (here); the meshed water of
+//! `"fe_incompressible"`: its Laplacian ([`fluid_mesh`]), the non-conforming wet-face coupling
+//! ([`transfer`]) and the condensed added-mass operator with its lumping ([`incompressible`]).
+//! Inputs: the mesh (the dam's wet face groups; the water's groups), the scene's `reservoir`.
+//! Outputs: nodal forces, nodal 3×3 added-mass blocks ([`added_masses_of_scene`]), and for
+//! `modes` the full FE operator beyond its lumping ([`coupled_added_mass_of_scene`]).
+//! Invariants: the seed's configuration (`"westergaard"`) is the default and unchanged; every
+//! model's blocks act along the nodal normal only.
 //!
 //! Conventions (written once, here): z is up (design §2); the pool level z_w and the reservoir
 //! bottom z_b are heights [m], H = z_w − z_b the depth at the dam; the wet faces are oriented
