@@ -67,7 +67,12 @@ DefineConstant[
   hr     = {25,   Min 0.1, Name "Parameters/Mesh/hr rock size at the dam [m]"},
   hrf    = {120,  Min 0.1, Name "Parameters/Mesh/hrf rock size at the far faces [m]"},
   ext    = {2,    Min 0.1, Name "Parameters/Rock/ext extent beyond the dam in units of H [-]"},
-  hex    = {1, Choices {0 = "tet4", 1 = "hex8 (monoliths 2..N)"}, Name "Parameters/Mesh/hex"}
+  hex    = {1, Choices {0 = "tet4", 1 = "hex8 (monoliths 2..N)"}, Name "Parameters/Mesh/hex"},
+  water  = {0, Choices {0 = "none", 1 = "meshed water volume"}, Name "Parameters/Water/water (issue 28)"},
+  dw     = {5,    Min 0, Name "Parameters/Water/dw freeboard: pool level H - dw [m]"},
+  Lw     = {3,    Min 0.1, Name "Parameters/Water/Lw water length upstream in units of the depth [-]"},
+  hw     = {0,    Min 0, Name "Parameters/Water/hw water size at the dam [m] (0: h)"},
+  hwf    = {0,    Min 0, Name "Parameters/Water/hwf water size at the far end [m] (0: 2 hw)"}
 ];
 
 NM = N + 1;                  // monoliths
@@ -583,6 +588,125 @@ For k In {0:NM}
 EndFor
 MeshSize{A1, A2, A3, A4, B1, B2, B3, B4} = hrf;
 
+// ------------------------------------------------------------------ water (water = 1)
+// The reservoir as a meshed volume (issue 28; docs/dam_physics.md "Reservoir models"), off by
+// default (the default meshes are unchanged). Pool level zw = H - dw; the water is the region
+// swept from the dam's upstream face below zw along -y to the far end y = ymin - Lw zw (Lw zw
+// upstream of the dam's most upstream point), over the valley (the rock's upstream strips,
+// extruded along y) and under the free surface z = zw. One sub-volume per wet monolith
+// (between the profiles of its joints on the upstream face, shared inside the water), the two
+// bank ends triangular (between the last wet joint and the point where the foundation outline
+// crosses zw). Own points and curves: the water does not conform with the dam face (its face
+// passes through the same joint profiles and arch at zw, so the two faceted surfaces differ
+// only by the meshes' chords) nor with the rock. Tet4 (Delaunay), hw at the dam, hwf far.
+// Groups: block:water, water:dam (wet face), water:surface (z = zw), water:far (y = yfar),
+// water:bed (valley floor and banks).
+// a corner of the wet outline at (wp_x, wp_y, wp_z): its point, its far copy, the line along -y
+Macro WCorner
+  wpn = newp; Point(wpn) = {wp_x, wp_y, wp_z, hw1};
+  wpf = newp; Point(wpf) = {wp_x, yfar, wp_z, hwf1};
+  wpl = newc; Line(wpl) = {wpn, wpf};
+Return
+// an arc of the upstream face at zw from corner (a0, a0f, x aX0) to (a1, a1f, x aX1): near
+// spline wan, far line waf
+Macro WArc
+  ap[] = {a0};
+  For ai In {1:3}
+    axx = aX0 + (aX1 - aX0) * ai / 4;
+    pt = newp; Point(pt) = {axx, wYu + axx*axx/(2*wRu), zw, hw1}; ap[] += pt;
+  EndFor
+  ap[] += a1;
+  wan = newc; Spline(wan) = {ap[]};
+  waf = newc; Line(waf) = {a0f, a1f};
+Return
+
+If (water == 1)
+  zw = H - dw;
+  yfar = ymin - Lw * zw;
+  hw1 = hw;
+  If (hw1 <= 0)
+    hw1 = h;
+  EndIf
+  hwf1 = hwf;
+  If (hwf1 <= 0)
+    hwf1 = 2 * hw1;
+  EndIf
+  kw1 = 0; kw2 = 0;
+  For k In {1:N}
+    If (Uz[k] < zw)
+      If (kw1 == 0)
+        kw1 = k;
+      EndIf
+      kw2 = k;
+    EndIf
+  EndFor
+  If (kw1 == 0 || dw >= H)
+    Error("arch_dam.geo: water = 1 but no joint's upstream foot is below the pool level H - dw = %g", zw);
+    Abort;
+  EndIf
+  az_z = zw; Call ArchAt;
+  wYu = az_Yu; wRu = az_Ru;
+  // the bank ends, where the foundation outline crosses zw
+  tq = (zw - Uz[kw1]) / (Uz[kw1-1] - Uz[kw1]);
+  wp_x = Ux[kw1] + tq*(Ux[kw1-1] - Ux[kw1]); wp_y = Uy[kw1] + tq*(Uy[kw1-1] - Uy[kw1]); wp_z = zw;
+  Call WCorner;
+  ELn = wpn; ELf = wpf; ELl = wpl; ELx = wp_x;
+  tq = (zw - Uz[kw2]) / (Uz[kw2+1] - Uz[kw2]);
+  wp_x = Ux[kw2] + tq*(Ux[kw2+1] - Ux[kw2]); wp_y = Uy[kw2] + tq*(Uy[kw2+1] - Uy[kw2]); wp_z = zw;
+  Call WCorner;
+  ERn = wpn; ERf = wpf; ERl = wpl; ERx = wp_x;
+  // each wet joint: foot F, top T (its upstream face at zw), the profile between (near spline,
+  // far spline) and the ruled side swept along -y (shared by the two sub-volumes beside it)
+  For k In {kw1:kw2}
+    wp_x = Ux[k]; wp_y = Uy[k]; wp_z = Uz[k];
+    Call WCorner;
+    WFn[k] = wpn; WFf[k] = wpf; WFl[k] = wpl;
+    fr_k = k; fr_f = 0; fr_z = zw; Call FaceR;
+    wp_x = jx[k] + fr_r*jdx[k]; wp_y = jy[k] + fr_r*jdy[k]; wp_z = zw;
+    Call WCorner;
+    WTn[k] = wpn; WTf[k] = wpf; WTl[k] = wpl; WTx[k] = wp_x;
+    pn[] = {WFn[k]}; pf[] = {WFf[k]};
+    For pi In {1:np-2}
+      fr_z = Uz[k] + (zw - Uz[k]) * pi / (np - 1);
+      Call FaceR;
+      pt = newp; Point(pt) = {jx[k] + fr_r*jdx[k], jy[k] + fr_r*jdy[k], fr_z, hw1}; pn[] += pt;
+      pt = newp; Point(pt) = {jx[k] + fr_r*jdx[k], yfar, fr_z, hwf1}; pf[] += pt;
+    EndFor
+    pn[] += WTn[k]; pf[] += WTf[k];
+    WPn[k] = newc; Spline(WPn[k]) = {pn[]};
+    WPf[k] = newc; Spline(WPf[k]) = {pf[]};
+    l = newcl; Curve Loop(l) = {WPn[k], WTl[k], -WPf[k], -WFl[k]}; WS[k] = news; Surface(WS[k]) = {l};
+  EndFor
+  waterV[] = {}; wetS[] = {}; topS[] = {}; farS[] = {}; bedS[] = {};
+  // left bank end: EL, F[kw1], T[kw1]
+  bn = newc; Line(bn) = {ELn, WFn[kw1]}; bf = newc; Line(bf) = {ELf, WFf[kw1]};
+  a0 = ELn; a0f = ELf; aX0 = ELx; a1 = WTn[kw1]; a1f = WTf[kw1]; aX1 = WTx[kw1]; Call WArc;
+  l = newcl; Curve Loop(l) = {bn, WPn[kw1], -wan}; s1 = news; Surface(s1) = {l}; wetS[] += s1;
+  l = newcl; Curve Loop(l) = {bf, WPf[kw1], -waf}; s2 = news; Plane Surface(s2) = {l}; farS[] += s2;
+  l = newcl; Curve Loop(l) = {bn, WFl[kw1], -bf, -ELl}; s3 = news; Plane Surface(s3) = {l}; bedS[] += s3;
+  l = newcl; Curve Loop(l) = {wan, WTl[kw1], -waf, -ELl}; s4 = news; Plane Surface(s4) = {l}; topS[] += s4;
+  sl = newsl; Surface Loop(sl) = {s1, s2, s3, s4, WS[kw1]}; v = newv; Volume(v) = {sl}; waterV[] += v;
+  // the wet monoliths between joints k-1 and k
+  For k In {kw1+1:kw2}
+    bn = newc; Line(bn) = {WFn[k-1], WFn[k]}; bf = newc; Line(bf) = {WFf[k-1], WFf[k]};
+    a0 = WTn[k-1]; a0f = WTf[k-1]; aX0 = WTx[k-1]; a1 = WTn[k]; a1f = WTf[k]; aX1 = WTx[k]; Call WArc;
+    l = newcl; Curve Loop(l) = {bn, WPn[k], -wan, -WPn[k-1]}; s1 = news; Surface(s1) = {l}; wetS[] += s1;
+    l = newcl; Curve Loop(l) = {bf, WPf[k], -waf, -WPf[k-1]}; s2 = news; Plane Surface(s2) = {l}; farS[] += s2;
+    l = newcl; Curve Loop(l) = {bn, WFl[k], -bf, -WFl[k-1]}; s3 = news; Plane Surface(s3) = {l}; bedS[] += s3;
+    l = newcl; Curve Loop(l) = {wan, WTl[k], -waf, -WTl[k-1]}; s4 = news; Plane Surface(s4) = {l}; topS[] += s4;
+    sl = newsl; Surface Loop(sl) = {s1, s2, s3, s4, WS[k-1], WS[k]}; v = newv; Volume(v) = {sl}; waterV[] += v;
+  EndFor
+  // right bank end: F[kw2], ER, T[kw2]
+  bn = newc; Line(bn) = {WFn[kw2], ERn}; bf = newc; Line(bf) = {WFf[kw2], ERf};
+  a0 = WTn[kw2]; a0f = WTf[kw2]; aX0 = WTx[kw2]; a1 = ERn; a1f = ERf; aX1 = ERx; Call WArc;
+  l = newcl; Curve Loop(l) = {bn, -wan, -WPn[kw2]}; s1 = news; Surface(s1) = {l}; wetS[] += s1;
+  l = newcl; Curve Loop(l) = {bf, -waf, -WPf[kw2]}; s2 = news; Plane Surface(s2) = {l}; farS[] += s2;
+  l = newcl; Curve Loop(l) = {bn, ERl, -bf, -WFl[kw2]}; s3 = news; Plane Surface(s3) = {l}; bedS[] += s3;
+  l = newcl; Curve Loop(l) = {wan, ERl, -waf, -WTl[kw2]}; s4 = news; Plane Surface(s4) = {l}; topS[] += s4;
+  sl = newsl; Surface Loop(sl) = {s1, s2, s3, s4, WS[kw2]}; v = newv; Volume(v) = {sl}; waterV[] += v;
+  Printf("arch_dam.geo: water to zw = %.3f m, far end y = %.3f m, wet joints %g..%g", zw, yfar, kw1, kw2);
+EndIf
+
 // ------------------------------------------------------------------ groups
 Physical Volume("block:monolith:01") = {wedge1[]};
 For m In {2:N}
@@ -609,6 +733,13 @@ Physical Surface("face:crest") = {crF[]};
 Physical Surface("interface:dam:base") = {baseF[]};
 Physical Surface("interface:rock:base") = {rockBase[]};
 Physical Surface("bc:far") = {farF[]};
+If (water == 1)
+  Physical Volume("block:water") = {waterV[]};
+  Physical Surface("water:dam") = {wetS[]};
+  Physical Surface("water:surface") = {topS[]};
+  Physical Surface("water:far") = {farS[]};
+  Physical Surface("water:bed") = {bedS[]};
+EndIf
 
 Mesh.MeshSizeExtendFromBoundary = 1;
 Mesh.MeshSizeFromCurvature = 0;

@@ -56,6 +56,8 @@ mesh column_hex.msh           column.geo -setnumber nz 10 -setnumber nw 1
 mesh wedge_coarse.msh         wedge.geo -setnumber hw 8 -setnumber hr 30
 # the arch dam's coarse variant (docs/dam.md): 29 monoliths, 28 joints, foundation block
 mesh arch_dam_coarse.msh      arch_dam.geo -setnumber h 20 -setnumber ht 3.4 -setnumber hr 40 -setnumber hrf 200
+# the same with its meshed water (issue 28: reservoir.model "fe_incompressible", pipelines/dam_coarse_fe.json)
+mesh arch_dam_coarse_water.msh arch_dam.geo -setnumber h 20 -setnumber ht 3.4 -setnumber hr 40 -setnumber hrf 200 -setnumber water 1
 
 # malformed.msh: boxes_hex_4x3.msh cut 5 lines into its $Elements section (no $EndElements).
 awk '{ print } /^\$Elements/ { cut = NR + 5 } cut && NR >= cut { exit }' \

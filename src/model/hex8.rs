@@ -48,7 +48,8 @@ fn hourglass_patterns() -> [[f64; 8]; 4] {
     h
 }
 
-fn dshape(xi: [f64; 3]) -> [[f64; 3]; 8] {
+/// Reference derivatives ∂N_a/∂ξ_k of the 8 shape functions at ξ.
+pub(crate) fn dshape(xi: [f64; 3]) -> [[f64; 3]; 8] {
     let mut d = [[0.0; 3]; 8];
     for a in 0..8 {
         let r = HEX8_REF[a];
@@ -60,7 +61,8 @@ fn dshape(xi: [f64; 3]) -> [[f64; 3]; 8] {
     d
 }
 
-fn jacobian(x: &[Vector3<f64>; 8], d: &[[f64; 3]; 8]) -> Matrix3<f64> {
+/// J[(i, k)] = ∂x_i/∂ξ_k from the corners and the reference derivatives.
+pub(crate) fn jacobian(x: &[Vector3<f64>; 8], d: &[[f64; 3]; 8]) -> Matrix3<f64> {
     let mut j = Matrix3::zeros();
     for a in 0..8 {
         for i in 0..3 {

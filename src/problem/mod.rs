@@ -61,7 +61,7 @@ impl Problem {
 /// of the wet nodes (no weight); a note with the total.
 pub fn add_reservoir_mass(model: &mut Model, scene: &Scene, r: &crate::scene::ReservoirScene) -> Result<String, Error> {
     let (faces, spec) = reservoir::wet_faces_of_scene(&model.mesh, scene, r)?;
-    let added = reservoir::added_masses(&model.mesh, &faces, &spec);
+    let (added, which) = reservoir::added_masses_of_scene(&model.mesh, r, &faces, &spec)?;
     let mut total = 0.0;
     for a in &added {
         if model.mass.inertial[a.node] == 0.0 {
@@ -75,5 +75,5 @@ pub fn add_reservoir_mass(model: &mut Model, scene: &Scene, r: &crate::scene::Re
         model.add_inertia(a.node, n * n.transpose() * a.mass);
         total += a.mass;
     }
-    Ok(format!("reservoir: added mass {:.4e} kg on {} wet nodes (depth {:.3} m, Westergaard/Kuo)", total, added.len(), spec.depth()))
+    Ok(format!("reservoir: added mass {:.4e} kg on {} wet nodes (depth {:.3} m, {which})", total, added.len(), spec.depth()))
 }

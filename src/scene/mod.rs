@@ -5,6 +5,7 @@
 //! file's directory. Units: SI (m, kg, s, Pa, N); record amplitudes are in g.
 
 pub mod patterns;
+pub mod reservoir;
 
 use crate::error::SceneError;
 use serde::{Deserialize, Serialize};
@@ -72,6 +73,13 @@ pub struct ReservoirScene {
     /// dam's banks; docs/dam.md, "Modes").
     #[serde(default = "default_added_mass_depth")]
     pub added_mass_depth: String,
+    /// The hydrodynamic model (`reservoir::ReservoirModel`): `"westergaard"` (default, the
+    /// seed's), `"westergaard_local"`, `"fe_incompressible"` (needs `fluid`). docs/scenes.md.
+    #[serde(default)]
+    pub model: reservoir::ReservoirModel,
+    /// The meshed water of `"fe_incompressible"` (`reservoir::FluidScene`). Default: none.
+    #[serde(default)]
+    pub fluid: Option<reservoir::FluidScene>,
 }
 
 fn default_added_mass_depth() -> String {
@@ -1025,6 +1033,7 @@ impl Scene {
             if !matches!(r.added_mass_depth.as_str(), "reservoir" | "local") {
                 return Err(format!("reservoir.added_mass_depth \"{}\" is not \"reservoir\" (the depth at the dam) or \"local\" (the depth of the node's section)", r.added_mass_depth));
             }
+            reservoir::validate(r.model, r.fluid.as_ref(), &r.added_mass_depth)?;
             if !r.level.is_finite() {
                 return Err("reservoir.level must be a finite height [m]".into());
             }

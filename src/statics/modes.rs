@@ -2,7 +2,9 @@
 //!
 //! K of every element (the massless blocks included, so their unknowns are condensed by the
 //! eigen-solver itself: M is singular there, see `linalg::eigen`), M the inertial mass with the
-//! reservoir's added-mass blocks, on the free dofs. The layer of a massless block along a joint
+//! reservoir's added-mass blocks, on the free dofs; with `reservoir.model: "fe_incompressible"`
+//! the full condensed added-mass operator (the model's blocks hold only its lumping; module
+//! problem::reservoir::incompressible). The layer of a massless block along a joint
 //! (mass without weight, kept only for the explicit contact force) is massless here too. Outputs: a table (frequency [Hz], period
 //! [s], ω² [1/s²], participation factor Γ_d = φᵀ M ι_d and effective modal mass Γ_d² [kg] along
 //! x, y, z with φ M-normalised, and that mass as a fraction of the total mass the ground moves
@@ -60,6 +62,13 @@ pub struct ModesReport {
 
 /// The `count` lowest modes of `problem`, with the shapes written under `out_dir/modes/`.
 pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesReport, Error> {
+    modes_with(problem, count, out_dir, true)
+}
+
+/// [`modes`], with the `"fe_incompressible"` reservoir's full added mass (`full_fluid_mass`,
+/// what `jointquake modes` uses) or only its lumping (the model's nodal blocks: the mass the
+/// explicit run integrates; to measure what the lumping loses).
+pub fn modes_with(problem: &Problem, count: usize, out_dir: &Path, full_fluid_mass: bool) -> Result<ModesReport, Error> {
     let t0 = std::time::Instant::now();
     if count == 0 {
         return Err(ModelError::Invalid("modes: -n must be at least 1".into()).into());
@@ -77,7 +86,14 @@ pub fn modes(problem: &Problem, count: usize, out_dir: &Path) -> Result<ModesRep
     // the massless foundation is massless here: the layer a massless block keeps along a joint
     // (mass without weight, for the explicit contact force) has no part in the modes
     let inertia: Vec<f64> = model.mass.inertial.iter().zip(&model.weightless).map(|(&m, &w)| if w { 0.0 } else { m }).collect();
-    let mff = t.reduce(&mass_matrix(&inertia, &blocks, &all, na));
+    // the incompressible FE reservoir: its full added mass (the model holds its lumping)
+    let mut m_all = mass_matrix(&inertia, &blocks, &all, na);
+    if full_fluid_mass {
+        if let Some(extra) = crate::problem::reservoir::coupled_added_mass_of_scene(&model.mesh, &problem.scene)? {
+            m_all = crate::linalg::add_entries(&m_all, &extra);
+        }
+    }
+    let mff = t.reduce(&m_all);
     let with_mass = (0..nf).filter(|&j| mff.get(j, j) > 0.0).count();
     let m = lowest_modes(&kff, &mff, &ModesOptions { count, ..Default::default() }).map_err(|e| ModelError::Invalid(e.to_string()))?;
     // influence vectors (a unit translation of the reduced unknowns is one of the whole model:

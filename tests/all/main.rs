@@ -20,6 +20,7 @@ mod motion;
 mod motion_scene;
 mod outputs;
 mod report;
+mod reservoir;
 mod rigid;
 mod study;
 mod tagging;
