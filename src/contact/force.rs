@@ -45,6 +45,53 @@ use crate::error::StepError;
 use crate::model::Model;
 use nalgebra::{Matrix3, Vector2, Vector3};
 
+/// The master side of one pair: up to four master nodes (`nm` used) with their weights `N_I`,
+/// and the master face (−1 for NTN).
+#[derive(Clone, Copy, Debug)]
+struct PairMasters {
+    nodes: [u32; 4],
+    nm: u8,
+    weights: [f64; 4],
+    face: i32,
+}
+
+/// A pair's mobility (module doc): the scalar `w` [1/kg], the inverse masses of its slave
+/// (`ims`) and masters (`imm`), whether it has a partly fixed or block node, and per node its
+/// free components (1 free, 0 fixed; all 1 unless partly fixed).
+#[derive(Clone, Copy, Debug)]
+struct Mobility {
+    w: f64,
+    ims: f64,
+    imm: [f64; 4],
+    partial: bool,
+    masks: [Vector3<f64>; 5],
+}
+
+/// The master side of slave node `i` projected at `p` on master face `f`; with `widen`, the
+/// node's candidate set is recentred on the face node it is nearest to (`report` keeps the
+/// initial set, by definition).
+fn masters_on_face(j: &ContactJoint, rec: &mut JointRecord, i: usize, f: usize, p: &super::query::Projection) -> PairMasters {
+    let local = j.tag.master.faces[f].local_nodes();
+    let (mut best, mut wmax) = (local[0], f64::MIN);
+    for (a, &l) in local.iter().enumerate() {
+        if p.weights[a] > wmax {
+            wmax = p.weights[a];
+            best = l;
+        }
+    }
+    if j.on_exit == OnExit::Widen && rec.pairs[i].center != best {
+        rec.pairs[i].center = best;
+        rec.events.recentred += 1;
+    }
+    let nodes = j.tag.master.faces[f].nodes();
+    let mut ms = [0u32; 4];
+    for (a, &nd) in nodes.iter().enumerate() {
+        ms[a] = nd;
+    }
+    rec.pairs[i].xi = p.xi;
+    PairMasters { nodes: ms, nm: nodes.len() as u8, weights: p.weights, face: f as i32 }
+}
+
 /// Per model node: where it is among the nodes of this step's active pairs.
 #[derive(Clone, Copy, Debug, Default)]
 struct NodeScratch {
@@ -614,143 +661,30 @@ impl ContactSolver<'_> {
         self.active.clear();
         self.mob_matrix.clear();
         self.penalty.clear();
-        let mut penalty_work = 0.0;
-        // ---------------------------------------------------------------- search
-        for (ji, j) in self.joints.iter().enumerate() {
+        let joints = self.joints;
+        for (ji, j) in joints.iter().enumerate() {
             let rec = &mut history.joints[ji];
             let penalty = matches!(j.method, Method::Penalty { .. });
             // penalty works on the configuration at t[n]; the dynamic force on the prediction
             let conf: &[f64] = if penalty { u } else { u_next };
             for i in 0..j.tag.n_slave() {
                 let s = j.tag.slave_nodes()[i];
-                let [n, t1, t2] = j.frames[i];
                 let xs = pos(model, conf, s);
-                let pr = rec.pairs[i];
-                let (masters, nm, weights, face) = match j.method {
-                    Method::Ntn => {
-                        let o = j.tag.nearest_master_node(i) as u32;
-                        ([o, 0, 0, 0], 1u8, [1.0, 0.0, 0.0, 0.0], -1i32)
-                    }
-                    _ => {
-                        // Temporal coherence: a node still strictly inside the face it was on at
-                        // the last step, and near it along its normal (within half the face
-                        // size, so that no other sheet of a folded master can be nearer), keeps
-                        // that face: the full search would choose it too (selection rules of
-                        // `select_projection`: nearest sheet, inside before edge, face id).
-                        let mut found = None;
-                        if pr.face >= 0 && j.law.tied {
-                            // A tied pair keeps the face it was tied to (a tie is made once and
-                            // kept, as tied contact does in LS-DYNA or Abaqus): the node is
-                            // projected on that face whatever its location (no inside test), so
-                            // a bonded node that a shear force carries dt² F / m past the face's
-                            // edge in the prediction is not lost (regression:
-                            // `tied_pure_shear_keeps_perimeter_nodes_at_the_default_edge_tolerance`).
-                            let f = pr.face as usize;
-                            found = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
-                        } else if pr.face >= 0 {
-                            let f = pr.face as usize;
-                            if let Some((p, edge2)) = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
-                                && p.location == Location::Inside
-                                && p.t * p.t <= 0.25 * edge2
-                            {
-                                found = Some((f, p));
-                            }
+                let pm = match j.method {
+                    Method::Ntn => PairMasters { nodes: [j.tag.nearest_master_node(i) as u32, 0, 0, 0], nm: 1, weights: [1.0, 0.0, 0.0, 0.0], face: -1 },
+                    _ => match self.nts_face_into(model, j, rec, i, &xs, conf) {
+                        Some((f, p)) => masters_on_face(j, rec, i, f, &p),
+                        None => {
+                            rec.events.lost += 1;
+                            let p = &mut rec.pairs[i];
+                            p.face = -1;
+                            p.gap = f64::NAN;
+                            p.r_n = 0.0;
+                            p.r_t = [0.0; 2];
+                            p.state = PairState::Open;
+                            continue;
                         }
-                        if found.is_none() {
-                            self.candidates_into(j, pr.center, j.layer);
-                            let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
-                            self.cand = cand;
-                        }
-                        if found.is_none() {
-                            // a node just off the master's free edge (see `edge_tolerance`)
-                            let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance);
-                            self.cand = cand;
-                            if found.is_some() {
-                                rec.events.perimeter_kept += 1;
-                            }
-                        }
-                        if found.is_none() && j.on_exit == OnExit::Widen {
-                            if j.layer < 2 {
-                                self.candidates_into(j, pr.center, 2);
-                                let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
-                                self.cand = cand;
-                                if found.is_some() {
-                                    rec.events.widened_layer2 += 1;
-                                }
-                            }
-                            if found.is_none() {
-                                // walk the master surface to the node nearest the slave's position
-                                let m = &j.tag.master;
-                                let mut c = pr.center as usize;
-                                let d = |l: usize| (pos(model, conf, m.nodes[l]) - xs).norm_squared();
-                                loop {
-                                    let mut best = (d(c), c);
-                                    for &f in m.faces_of_node(c) {
-                                        for &v in m.faces[f as usize].local_nodes() {
-                                            let dv = d(v as usize);
-                                            if dv < best.0 || (dv == best.0 && (v as usize) < best.1) {
-                                                best = (dv, v as usize);
-                                            }
-                                        }
-                                    }
-                                    if best.1 == c {
-                                        break;
-                                    }
-                                    c = best.1;
-                                }
-                                rec.events.fresh_searches += 1;
-                                rec.pairs[i].center = c as u32;
-                                // Layer2 around the new centre; around the old one it was just
-                                // tried (above, or as the joint's own layer), with the same
-                                // result: a node that stays lost (outside the master, next to
-                                // its edge) costs one Layer2 search a step, not two
-                                if c != pr.center as usize {
-                                    self.candidates_into(j, c as u32, 2);
-                                    let cand = std::mem::take(&mut self.cand);
-                                    found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
-                                    self.cand = cand;
-                                }
-                            }
-                        }
-                        match found {
-                            Some((f, p)) => {
-                                // `widen`: keep the candidate set centred on the node the slave is
-                                // nearest to (`report` keeps the initial set, by definition)
-                                let local = j.tag.master.faces[f].local_nodes();
-                                let (mut best, mut wmax) = (local[0], f64::MIN);
-                                for (a, &l) in local.iter().enumerate() {
-                                    if p.weights[a] > wmax {
-                                        wmax = p.weights[a];
-                                        best = l;
-                                    }
-                                }
-                                if j.on_exit == OnExit::Widen && rec.pairs[i].center != best {
-                                    rec.pairs[i].center = best;
-                                    rec.events.recentred += 1;
-                                }
-                                let nodes = j.tag.master.faces[f].nodes();
-                                let mut ms = [0u32; 4];
-                                for (a, &nd) in nodes.iter().enumerate() {
-                                    ms[a] = nd;
-                                }
-                                rec.pairs[i].xi = p.xi;
-                                (ms, nodes.len() as u8, p.weights, f as i32)
-                            }
-                            None => {
-                                rec.events.lost += 1;
-                                let p = &mut rec.pairs[i];
-                                p.face = -1;
-                                p.gap = f64::NAN;
-                                p.r_n = 0.0;
-                                p.r_t = [0.0; 2];
-                                p.state = PairState::Open;
-                                continue;
-                            }
-                        }
-                    }
+                    },
                 };
                 // A pair whose slave node is the slave of a (later) tied joint is not formed
                 // (`joint::unformed_pairs`: the tie fixes the node): reported bonded, with no
@@ -762,141 +696,281 @@ impl ContactSolver<'_> {
                     p.r_t = [0.0; 2];
                     continue;
                 }
-                let ims = self.inv_mass[s];
-                let mut imm = [0.0; 4];
-                let mut w = ims;
-                for a in 0..nm as usize {
-                    imm[a] = self.inv_mass[masters[a] as usize];
-                    w += weights[a] * weights[a] * imm[a];
-                }
-                // a partly fixed node in the pair: the mobility per component, W = Σ c² P / m
-                // (diagonal); the update's scalar is its largest entry (module doc)
-                let partly_fixed = !self.partial.is_empty() && (self.is_partial(s as u32) || masters[..nm as usize].iter().any(|&m| self.is_partial(m)));
-                let is_block = |nd: u32| !self.block_nodes.is_empty() && self.block_nodes.binary_search(&nd).is_ok();
-                let on_block = is_block(s as u32) || masters[..nm as usize].iter().any(|&m| is_block(m));
-                let mut masks = [Vector3::repeat(1.0); 5];
-                if partly_fixed {
-                    masks[0] = free_mask(model, s);
-                    let mut wv = masks[0] * ims;
-                    for a in 0..nm as usize {
-                        masks[a + 1] = free_mask(model, masters[a] as usize);
-                        wv += masks[a + 1] * (weights[a] * weights[a] * imm[a]);
-                    }
-                    if wv.dot(&n.component_mul(&n)) == 0.0 {
-                        // no node of the pair can move along its normal: no contact force
-                        continue;
-                    }
-                    w = wv.max();
-                }
-                if w == 0.0 {
-                    continue;
-                }
+                let Some(mobility) = self.pair_mobility(model, s, &j.frames[i][0], &pm) else { continue };
                 if let Method::Penalty { kn, kt } = j.method {
-                    // current gap and relative displacement on the configuration at t[n]
-                    let mut xbar = Vector3::zeros();
-                    let mut um_n = Vector3::zeros();
-                    for a in 0..nm as usize {
-                        let mi = masters[a] as usize;
-                        xbar += pos(model, conf, mi) * weights[a];
-                        um_n += disp(u, mi) * weights[a];
-                    }
-                    let gap = n.dot(&(xbar - xs)) - rec.pairs[i].gap_offset;
-                    // explicit penalty at t[n]: tangential increment over the last step
-                    let mut um_p = Vector3::zeros();
-                    for a in 0..nm as usize {
-                        um_p += disp(u_prev, masters[a] as usize) * weights[a];
-                    }
-                    let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
-                    let area = j.tag.areas[i];
-                    let p = &mut rec.pairs[i];
-                    let ddt = Vector2::new(dd.dot(&t1), dd.dot(&t2));
-                    let resp = penalty_force(&self.law_in_force(j), &p.hist, gap, Vector2::new(p.r_t[0], p.r_t[1]), ddt, kn * area, kt * area, area);
-                    p.hist = resp.hist;
-                    let (r_n, r_t, state) = (resp.r_n, resp.r_t, resp.state);
-                    let rvec = -n * r_n + t1 * r_t.x + t2 * r_t.y;
-                    p.d_t[0] += dd.dot(&t1);
-                    p.d_t[1] += dd.dot(&t2);
-                    p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
-                    p.gap = gap;
-                    p.face = face;
-                    p.r_n = r_n;
-                    p.r_t = [r_t.x, r_t.y];
-                    p.state = state;
-                    self.penalty.push((s as u32, masters, nm, weights, rvec));
-                    continue;
+                    self.penalty_pair_into(model, j, rec, i, &pm, (kn, kt), &xs, u_prev, u);
+                } else {
+                    self.active_pair_into(model, j, ji, rec, i, &pm, &mobility, dt2, u);
                 }
-                let warm = self.gs_warm_start && pr.state != PairState::Open;
-                let mut xbar0 = -Vector3::from(model.mesh.nodes[s]);
-                let mut rel_u = -disp(u, s);
-                for a in 0..nm as usize {
-                    let mi = masters[a] as usize;
-                    xbar0 += Vector3::from(model.mesh.nodes[mi]) * weights[a];
-                    rel_u += disp(u, mi) * weights[a];
-                }
-                let mut nodes5 = [s as u32; 5];
-                let mut coef = [-1.0, 0.0, 0.0, 0.0, 0.0];
-                let mut mob = [0.0; 5];
-                if ims > 0.0 {
-                    mob[0] = dt2 * ims;
-                }
-                for b in 0..nm as usize {
-                    nodes5[b + 1] = masters[b];
-                    coef[b + 1] = weights[b];
-                    let imi = imm[b];
-                    if imi > 0.0 {
-                        mob[b + 1] = -dt2 * weights[b] * imi;
-                    }
-                }
-                if !self.partial.is_empty() || !self.block_nodes.is_empty() {
-                    // one entry per active pair (indexed like `active`), read when `partial`:
-                    // the displacement a unit pair force gives each node, mob × its free
-                    // components, or at a node with an inertia block ±dt² N M⁻¹ (the block's
-                    // inverse, restricted to the free components; docs/contact.md, "Mobility
-                    // of an anisotropic mass")
-                    let nodes_b = nodes5;
-                    self.mob_matrix.push(std::array::from_fn(|b| match model.mass.block_of(nodes_b[b] as usize) {
-                        Some(blk) if b <= nm as usize && self.inv_mass[nodes_b[b] as usize] > 0.0 => blk.inverse * (mob[b] / self.inv_mass[nodes_b[b] as usize]),
-                        _ => Matrix3::from_diagonal(&masks[b]) * mob[b],
-                    }));
-                }
-                self.active.push(Active {
-                    nodes: nodes5,
-                    local: [0; 5],
-                    partial: partly_fixed || on_block,
-                    mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
-                    coef,
-                    mob,
-                    frame: j.frames[i],
-                    area: j.tag.areas[i],
-                    hist0: pr.hist,
-                    // the grouted gap counts as closed (0 unless grouted)
-                    gap0: n.dot(&xbar0) - pr.gap_offset,
-                    rel_u,
-                    joint: ji as u32,
-                    pair: i as u32,
-                    nm,
-                    dt2w: dt2 * w,
-                    inv_dt2w: 1.0 / (dt2 * w),
-                    // warm start: a pair in contact at the last step starts from its last force
-                    r_n: if warm { pr.r_n } else { 0.0 },
-                    r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
-                    hist: pr.hist,
-                    state: PairState::Open,
-                    // set by the first sweep, which evaluates every pair
-                    gap: f64::NAN,
-                });
-                rec.pairs[i].face = face;
             }
         }
+        self.apply_penalty_into(model, dt2, u_prev, u_next)
+    }
 
-        // penalty forces of step n act like external forces on the prediction
+    /// The master face of slave node `i` of joint `j` (node-to-segment search on `conf`): the
+    /// face of the last step when the node is still inside it, else its candidate set, the
+    /// master's free edge within `edge_tolerance`, and with `widen` Layer2 and a fresh
+    /// nearest-node search (module doc). `None`: the node found no face.
+    fn nts_face_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
+        let n = j.frames[i][0];
+        let pr = rec.pairs[i];
+        // Temporal coherence: a node still strictly inside the face it was on at
+        // the last step, and near it along its normal (within half the face
+        // size, so that no other sheet of a folded master can be nearer), keeps
+        // that face: the full search would choose it too (selection rules of
+        // `select_projection`: nearest sheet, inside before edge, face id).
+        let mut found = None;
+        if pr.face >= 0 && j.law.tied {
+            // A tied pair keeps the face it was tied to (a tie is made once and
+            // kept, as tied contact does in LS-DYNA or Abaqus): the node is
+            // projected on that face whatever its location (no inside test), so
+            // a bonded node that a shear force carries dt² F / m past the face's
+            // edge in the prediction is not lost (regression:
+            // `tied_pure_shear_keeps_perimeter_nodes_at_the_default_edge_tolerance`).
+            let f = pr.face as usize;
+            found = project_on_face(model, j, f, xs, &n, conf, &mut rec.events.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
+        } else if pr.face >= 0 {
+            let f = pr.face as usize;
+            if let Some((p, edge2)) = project_on_face(model, j, f, xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
+                && p.location == Location::Inside
+                && p.t * p.t <= 0.25 * edge2
+            {
+                found = Some((f, p));
+            }
+        }
+        if found.is_none() {
+            self.candidates_into(j, pr.center, j.layer);
+            found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+        }
+        if found.is_none() {
+            // a node just off the master's free edge (see `edge_tolerance`)
+            found = self.project_on_candidates(model, j, rec, xs, &n, conf, j.edge_tolerance);
+            if found.is_some() {
+                rec.events.perimeter_kept += 1;
+            }
+        }
+        if found.is_none() && j.on_exit == OnExit::Widen {
+            found = self.widen_into(model, j, rec, i, xs, conf);
+        }
+        found
+    }
+
+    /// Project on the candidate faces in `cand` (tolerance `tol`).
+    #[allow(clippy::too_many_arguments)]
+    fn project_on_candidates(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, xs: &Vector3<f64>, n: &Vector3<f64>, conf: &[f64], tol: f64) -> Option<(usize, super::query::Projection)> {
+        let cand = std::mem::take(&mut self.cand);
+        let found = project_on(model, j, &cand, xs, n, conf, &mut rec.events.projection_failures, tol);
+        self.cand = cand;
+        found
+    }
+
+    /// `widen` (slave node `i` left its candidate set): Layer2 around the centre, then a walk on
+    /// the master surface to the node nearest the slave's position, which becomes the centre.
+    fn widen_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
+        let n = j.frames[i][0];
+        let pr = rec.pairs[i];
+        let mut found = None;
+        if j.layer < 2 {
+            self.candidates_into(j, pr.center, 2);
+            found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+            if found.is_some() {
+                rec.events.widened_layer2 += 1;
+            }
+        }
+        if found.is_none() {
+            // walk the master surface to the node nearest the slave's position
+            let m = &j.tag.master;
+            let mut c = pr.center as usize;
+            let d = |l: usize| (pos(model, conf, m.nodes[l]) - xs).norm_squared();
+            loop {
+                let mut best = (d(c), c);
+                for &f in m.faces_of_node(c) {
+                    for &v in m.faces[f as usize].local_nodes() {
+                        let dv = d(v as usize);
+                        if dv < best.0 || (dv == best.0 && (v as usize) < best.1) {
+                            best = (dv, v as usize);
+                        }
+                    }
+                }
+                if best.1 == c {
+                    break;
+                }
+                c = best.1;
+            }
+            rec.events.fresh_searches += 1;
+            rec.pairs[i].center = c as u32;
+            // Layer2 around the new centre; around the old one it was just
+            // tried (above, or as the joint's own layer), with the same
+            // result: a node that stays lost (outside the master, next to
+            // its edge) costs one Layer2 search a step, not two
+            if c != pr.center as usize {
+                self.candidates_into(j, c as u32, 2);
+                found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+            }
+        }
+        found
+    }
+
+    /// The pair's mobility (module doc): `None` when the pair can take no force (no node of it
+    /// moves along its normal).
+    fn pair_mobility(&self, model: &Model, s: usize, n: &Vector3<f64>, pm: &PairMasters) -> Option<Mobility> {
+        let (masters, nm, weights) = (&pm.nodes, pm.nm, &pm.weights);
+        let ims = self.inv_mass[s];
+        let mut imm = [0.0; 4];
+        let mut w = ims;
+        for a in 0..nm as usize {
+            imm[a] = self.inv_mass[masters[a] as usize];
+            w += weights[a] * weights[a] * imm[a];
+        }
+        // a partly fixed node in the pair: the mobility per component, W = Σ c² P / m
+        // (diagonal); the update's scalar is its largest entry (module doc)
+        let partly_fixed = !self.partial.is_empty() && (self.is_partial(s as u32) || masters[..nm as usize].iter().any(|&m| self.is_partial(m)));
+        let is_block = |nd: u32| !self.block_nodes.is_empty() && self.block_nodes.binary_search(&nd).is_ok();
+        let on_block = is_block(s as u32) || masters[..nm as usize].iter().any(|&m| is_block(m));
+        let mut masks = [Vector3::repeat(1.0); 5];
+        if partly_fixed {
+            masks[0] = free_mask(model, s);
+            let mut wv = masks[0] * ims;
+            for a in 0..nm as usize {
+                masks[a + 1] = free_mask(model, masters[a] as usize);
+                wv += masks[a + 1] * (weights[a] * weights[a] * imm[a]);
+            }
+            if wv.dot(&n.component_mul(n)) == 0.0 {
+                // no node of the pair can move along its normal: no contact force
+                return None;
+            }
+            w = wv.max();
+        }
+        if w == 0.0 {
+            return None;
+        }
+        Some(Mobility { w, ims, imm, partial: partly_fixed || on_block, masks })
+    }
+
+    /// A penalty pair (`Method::Penalty`): its force of step n from the configuration at t[n],
+    /// recorded in the history and queued in `penalty` for the prediction.
+    #[allow(clippy::too_many_arguments)]
+    fn penalty_pair_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, pm: &PairMasters, (kn, kt): (f64, f64), xs: &Vector3<f64>, u_prev: &[f64], u: &[f64]) {
+        let (masters, nm, weights) = (pm.nodes, pm.nm, pm.weights);
+        let s = j.tag.slave_nodes()[i];
+        let [n, t1, t2] = j.frames[i];
+        // current gap and relative displacement on the configuration at t[n]
+        let mut xbar = Vector3::zeros();
+        let mut um_n = Vector3::zeros();
+        for a in 0..nm as usize {
+            let mi = masters[a] as usize;
+            xbar += pos(model, u, mi) * weights[a];
+            um_n += disp(u, mi) * weights[a];
+        }
+        let gap = n.dot(&(xbar - xs)) - rec.pairs[i].gap_offset;
+        // explicit penalty at t[n]: tangential increment over the last step
+        let mut um_p = Vector3::zeros();
+        for a in 0..nm as usize {
+            um_p += disp(u_prev, masters[a] as usize) * weights[a];
+        }
+        let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
+        let area = j.tag.areas[i];
+        let p = &mut rec.pairs[i];
+        let ddt = Vector2::new(dd.dot(&t1), dd.dot(&t2));
+        let resp = penalty_force(&self.law_in_force(j), &p.hist, gap, Vector2::new(p.r_t[0], p.r_t[1]), ddt, kn * area, kt * area, area);
+        p.hist = resp.hist;
+        let (r_n, r_t, state) = (resp.r_n, resp.r_t, resp.state);
+        let rvec = -n * r_n + t1 * r_t.x + t2 * r_t.y;
+        p.d_t[0] += dd.dot(&t1);
+        p.d_t[1] += dd.dot(&t2);
+        p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
+        p.gap = gap;
+        p.face = pm.face;
+        p.r_n = r_n;
+        p.r_t = [r_t.x, r_t.y];
+        p.state = state;
+        self.penalty.push((s as u32, masters, nm, weights, rvec));
+    }
+
+    /// A dynamic-force pair into the active list (`active`, and `mob_matrix` when the model has
+    /// partly fixed or block nodes), warm-started from its force of the last step.
+    #[allow(clippy::too_many_arguments)]
+    fn active_pair_into(&mut self, model: &Model, j: &ContactJoint, ji: usize, rec: &mut JointRecord, i: usize, pm: &PairMasters, mob_of: &Mobility, dt2: f64, u: &[f64]) {
+        let (masters, nm, weights) = (pm.nodes, pm.nm, pm.weights);
+        let s = j.tag.slave_nodes()[i];
+        let n = j.frames[i][0];
+        let pr = rec.pairs[i];
+        let warm = self.gs_warm_start && pr.state != PairState::Open;
+        let mut xbar0 = -Vector3::from(model.mesh.nodes[s]);
+        let mut rel_u = -disp(u, s);
+        for a in 0..nm as usize {
+            let mi = masters[a] as usize;
+            xbar0 += Vector3::from(model.mesh.nodes[mi]) * weights[a];
+            rel_u += disp(u, mi) * weights[a];
+        }
+        let mut nodes5 = [s as u32; 5];
+        let mut coef = [-1.0, 0.0, 0.0, 0.0, 0.0];
+        let mut mob = [0.0; 5];
+        if mob_of.ims > 0.0 {
+            mob[0] = dt2 * mob_of.ims;
+        }
+        for b in 0..nm as usize {
+            nodes5[b + 1] = masters[b];
+            coef[b + 1] = weights[b];
+            let imi = mob_of.imm[b];
+            if imi > 0.0 {
+                mob[b + 1] = -dt2 * weights[b] * imi;
+            }
+        }
+        if !self.partial.is_empty() || !self.block_nodes.is_empty() {
+            // one entry per active pair (indexed like `active`), read when `partial`:
+            // the displacement a unit pair force gives each node, mob × its free
+            // components, or at a node with an inertia block ±dt² N M⁻¹ (the block's
+            // inverse, restricted to the free components; docs/contact.md, "Mobility
+            // of an anisotropic mass")
+            let nodes_b = nodes5;
+            let masks = mob_of.masks;
+            self.mob_matrix.push(std::array::from_fn(|b| match model.mass.block_of(nodes_b[b] as usize) {
+                Some(blk) if b <= nm as usize && self.inv_mass[nodes_b[b] as usize] > 0.0 => blk.inverse * (mob[b] / self.inv_mass[nodes_b[b] as usize]),
+                _ => Matrix3::from_diagonal(&masks[b]) * mob[b],
+            }));
+        }
+        let w = mob_of.w;
+        self.active.push(Active {
+            nodes: nodes5,
+            local: [0; 5],
+            partial: mob_of.partial,
+            mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
+            coef,
+            mob,
+            frame: j.frames[i],
+            area: j.tag.areas[i],
+            hist0: pr.hist,
+            // the grouted gap counts as closed (0 unless grouted)
+            gap0: n.dot(&xbar0) - pr.gap_offset,
+            rel_u,
+            joint: ji as u32,
+            pair: i as u32,
+            nm,
+            dt2w: dt2 * w,
+            inv_dt2w: 1.0 / (dt2 * w),
+            // warm start: a pair in contact at the last step starts from its last force
+            r_n: if warm { pr.r_n } else { 0.0 },
+            r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
+            hist: pr.hist,
+            state: PairState::Open,
+            // set by the first sweep, which evaluates every pair
+            gap: f64::NAN,
+        });
+        rec.pairs[i].face = pm.face;
+    }
+
+    /// The penalty forces of step n applied to the prediction like external forces; returns
+    /// their work over the step [J].
+    fn apply_penalty_into(&self, model: &Model, dt2: f64, u_prev: &[f64], u_next: &mut [f64]) -> f64 {
+        let mut penalty_work = 0.0;
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             add_pair_force_into(u_next, &self.inv_mass, dt2, s, &masters[..nm as usize], &weights, &rvec);
             if !self.block_nodes.is_empty() {
                 // a penalty force is an external force: at a block node its displacement is
                 // dt² M⁻¹ R with the full inverse, not the scalar of `inv_mass`
                 let r = |k: usize| if k == 0 { rvec } else { -rvec * weights[k - 1] };
-                for (k, &nd) in std::iter::once(&(s as u32)).chain(&masters[..nm as usize]).enumerate() {
+                for (k, &nd) in std::iter::once(&s).chain(&masters[..nm as usize]).enumerate() {
                     if self.block_nodes.binary_search(&nd).is_ok() {
                         let b = model.mass.block_of(nd as usize).expect("a block node");
                         let i0 = 3 * nd as usize;
