@@ -41,6 +41,7 @@
 pub mod force;
 pub mod joint;
 pub mod law;
+pub mod mortar;
 pub mod query;
 pub mod state;
 
