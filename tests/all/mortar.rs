@@ -107,3 +107,65 @@ fn mortar_contact_conserves_momentum() {
         assert!((p[c] - want).abs() < 1e-9 * scale, "momentum component {c}: {} vs n dt F = {want}", p[c]);
     }
 }
+
+/// Pressure and shear (p = 1 MPa, τ = 0.3 MPa < μ p: the joint sticks) on non-conforming pairs
+/// either side slave, and pressure on shifted (interior grid lines moved by 0.3 h) and turned
+/// (upper mesh turned 15° in the joint plane) meshes. The shear patch is not exact with any
+/// method here: conforming NTS gives 7.2e-4 (hex3-hex3-nts-shear, docs/validation.md §8), the
+/// incremental stick of the ramped load leaves that much; mortar's first case measured 1.1e-3
+/// (NTS on the same pair 8.4 %). Bound 1e-2 of max(p, |τ|) on every stress component next to
+/// the joint and on the contact tractions (NTS on these cases: 6.6–27.7 %); the measured values
+/// are printed and quoted in docs/validation.md §8. The residual-1e-12 run shows the pressure
+/// patch's 6e-7 on a tet slave is the static solve's, not the mortar's: it falls with the
+/// residual.
+#[test]
+fn mortar_patch_shear_shifted_and_turned_beat_nts() {
+    let mut worst: f64 = 0.0;
+    for v in [
+        json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "shear": 3e5}),
+        json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "upper", "shear": 3e5}),
+        json!({"kind": "patch", "lower": "tet4:4", "upper": "hex8:3", "slave": "lower", "shear": 3e5}),
+        json!({"kind": "patch", "lower": "mixed:4", "upper": "mixed:3", "slave": "lower", "shear": 3e5}),
+        json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "offset": 0.3}),
+        json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "offset": 0.3, "slave": "lower"}),
+        json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "rotate": 15.0}),
+        json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "rotate": 15.0}),
+        json!({"kind": "patch", "lower": "tet4:3", "upper": "tet4:3", "offset": 0.3, "rotate": 15.0}),
+    ] {
+        let mut v = v;
+        v["method"] = json!("mortar");
+        let r = case(v.clone());
+        let (s, p, t) = patch_errors(&r);
+        println!("MEASURED {v}: σ {s:.3e}, pressure {p:.3e}, shear {t:.3e}");
+        worst = worst.max(s).max(p).max(t);
+        assert!(s < 1e-2 && p < 1e-2 && t < 1e-2, "{v}: σ {s:.2e}, pressure {p:.2e}, shear {t:.2e}");
+    }
+    println!("worst {worst:.2e}");
+    let loose = case(json!({"kind": "patch", "lower": "tet4:4", "upper": "hex8:3", "slave": "lower", "method": "mortar"}));
+    let tight = case(json!({"kind": "patch", "lower": "tet4:4", "upper": "hex8:3", "slave": "lower", "method": "mortar", "residual": 1e-12}));
+    let (sl, st) = (patch_errors(&loose).0, patch_errors(&tight).0);
+    println!("MEASURED tet4:4/hex8:3: σ {sl:.2e} at residual 1e-10, {st:.2e} at 1e-12");
+    assert!(st < sl, "the patch error does not fall with the static solve's residual: {sl:.2e} → {st:.2e}");
+}
+
+/// The dynamic kinds with mortar against the NTS figures of docs/validation.md §8 (bounds 1.25 ×
+/// those): the block sliding down a 30° incline, s(t) = ½ g (sin β − μ cos β) t² (NTS 0.096 %
+/// hex, 0.091 % tet, 0.083 % shifted), the rigid Newmark block under El Centro at 0.5 g (NTS
+/// 2.06 %), and the two-bar impact, plateau force ρ c A v0 / 2 (NTS 0.0153 % on hex 2 × 2 against
+/// 3 × 3), whose contact must create no energy (contact work ≤ 1e-9 of the bar's kinetic energy).
+#[test]
+fn mortar_slide_newmark_and_impact_within_the_nts_errors() {
+    for (v, bound) in [
+        (json!({"kind": "slide", "method": "mortar"}), 1.25 * 0.096e-2),
+        (json!({"kind": "slide", "upper": "tet4:4:2", "method": "mortar"}), 1.25 * 0.0914e-2),
+        (json!({"kind": "slide", "offset": 0.3, "method": "mortar"}), 1.25 * 0.0833e-2),
+        (json!({"kind": "newmark", "method": "mortar"}), 1.25 * 2.06e-2),
+        (json!({"kind": "impact", "lower": "hex8:2:100", "upper": "hex8:3:100", "method": "mortar"}), 1.25 * 0.0153e-2),
+    ] {
+        let r = case(v.clone());
+        assert!(r.error < bound, "{v}: error {:.3e} above the NTS bound {bound:.3e}", r.error);
+        if let Errors::Impact { contact_work, .. } = r.errors {
+            assert!(contact_work < 1e-9, "{v}: the contact created energy: work {contact_work:.3e} of the initial kinetic energy");
+        }
+    }
+}
