@@ -23,6 +23,12 @@
 //! `JQ_BENCH_TIED_STEPS` steps per repeat (default 50) and 3 repeats, against its contact-free
 //! model; reported as the step ratio and the cost per pair per step, as for the main case.
 //! `JQ_BENCH_TIED_N=0` skips it.
+//!
+//! Mortar case (issue 31), after the tied case: the main case's frictional joint at
+//! `JQ_BENCH_MORTAR_N` (default 100: 10⁴ slave nodes), once with NTS and once with
+//! `method: "mortar"` (integrals re-evaluated every step), `JQ_BENCH_MORTAR_STEPS` steps per
+//! repeat (default 50), 3 repeats, each against the contact-free model; reported as the cost per
+//! pair per step of each method and their ratio (goal ≤ 3). `JQ_BENCH_MORTAR_N=0` skips it.
 use jointquake::mesh::structured::{add_box, BoxSpec};
 use jointquake::mesh::Mesh;
 use jointquake::problem::Problem;
@@ -33,10 +39,12 @@ fn build(n: usize, with_joint: bool) -> Problem {
     build_with(n, with_joint, false)
 }
 
+/// The main case's model with its joint's contact method `method` (frictional, μ = 0.5).
+fn build_method(n: usize, method: &str) -> Problem {
+    build_joints(n, serde_json::json!([{"name": "J", "master": "lower:z1", "slave": "upper:z0", "mu": 0.5, "method": method}]))
+}
+
 fn build_with(n: usize, with_joint: bool, tied: bool) -> Problem {
-    let mut mesh = Mesh { source: "<bench>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
-    add_box(&mut mesh, &BoxSpec::new("lower", [1.0, 1.0, 0.2], [n, n, 4]).at([0.0, 0.0, -0.2]));
-    add_box(&mut mesh, &BoxSpec::new("upper", [1.0, 1.0, 0.2], [n - 1, n - 1, 4]));
     let joints = if with_joint && tied {
         serde_json::json!([{"name": "J", "master": "lower:z1", "slave": "upper:z0", "mu": 0.5, "tied": true}])
     } else if with_joint {
@@ -44,6 +52,13 @@ fn build_with(n: usize, with_joint: bool, tied: bool) -> Problem {
     } else {
         serde_json::json!([])
     };
+    build_joints(n, joints)
+}
+
+fn build_joints(n: usize, joints: serde_json::Value) -> Problem {
+    let mut mesh = Mesh { source: "<bench>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
+    add_box(&mut mesh, &BoxSpec::new("lower", [1.0, 1.0, 0.2], [n, n, 4]).at([0.0, 0.0, -0.2]));
+    add_box(&mut mesh, &BoxSpec::new("upper", [1.0, 1.0, 0.2], [n - 1, n - 1, 4]));
     let sc: jointquake::scene::Scene = serde_json::from_value(serde_json::json!({
         "geometry": {"msh": "unused.msh"},
         "materials": [{"group": "block:lower", "E": 1e9, "nu": 0.25, "rho": 2000.0},
@@ -166,6 +181,7 @@ fn main() {
         let _ = std::fs::create_dir_all("target/bench");
         let _ = std::fs::write("target/bench/contact.json", serde_json::to_string_pretty(&json).unwrap());
         tied_case();
+        mortar_case();
     });
 }
 
@@ -207,4 +223,56 @@ fn tied_case() {
         "step_contact_free_us": t_free, "step_tied_us": t_tied, "ratio": ratio, "per_pair_us": per_pair, "sweeps_per_step": sweeps,
     });
     let _ = std::fs::write("target/bench/contact_tied.json", serde_json::to_string_pretty(&json).unwrap());
+}
+
+/// Mortar against NTS on the same frictional interface (module docs): per pair per step.
+fn mortar_case() {
+    let n: usize = std::env::var("JQ_BENCH_MORTAR_N").ok().and_then(|v| v.parse().ok()).unwrap_or(100);
+    if n < 2 {
+        return;
+    }
+    let steps: usize = std::env::var("JQ_BENCH_MORTAR_STEPS").ok().and_then(|v| v.parse().ok()).unwrap_or(50);
+    let repeats = 3;
+    let free = build_with(n, false, false);
+    let nts = build_method(n, "nts");
+    let mortar = build_method(n, "mortar");
+    let mut a = Run::new(&free);
+    let mut b = Run::new(&nts);
+    let mut c = Run::new(&mortar);
+    a.steps(steps);
+    b.steps(steps);
+    c.steps(steps);
+    b.sweeps = 0;
+    c.sweeps = 0;
+    c.sim.contact.as_mut().unwrap().timings = Some(Default::default());
+    let (mut per_nts, mut per_mortar, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut pairs_nts, mut pairs_mortar) = (0, 0);
+    for _ in 0..repeats {
+        let tf = a.steps(steps);
+        let tn = b.steps(steps);
+        let tm = c.steps(steps);
+        pairs_nts = b.active_pairs();
+        pairs_mortar = c.active_pairs();
+        let pn = 1e6 * (tn - tf) / (pairs_nts.max(1) * steps) as f64;
+        let pm = 1e6 * (tm - tf) / (pairs_mortar.max(1) * steps) as f64;
+        per_nts.push(pn);
+        per_mortar.push(pm);
+        ratio.push(pm / pn);
+    }
+    let best = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let sweeps = |r: &Run| r.sweeps as f64 / (repeats * steps) as f64;
+    let parts = c.sim.contact.as_ref().unwrap().timings.clone().unwrap();
+    let per_step = |d: std::time::Duration| 1e6 * d.as_secs_f64() / parts.steps.max(1) as f64;
+    println!("mortar against NTS (1 thread): n = {n}, {} nodes, {} hex8, {} slave nodes; pairs in contact NTS {pairs_nts}, mortar {pairs_mortar}", mortar.model.n_nodes(), mortar.model.n_elements(), mortar.joints[0].tag.n_slave());
+    println!("  {repeats} repeats of {steps} steps; best / median");
+    println!("  per pair, NTS       {:9.3} / {:9.3} µs per step, Gauss–Seidel sweeps {:.1} per step", best(&per_nts), median(&per_nts), sweeps(&b));
+    println!("  per pair, mortar    {:9.3} / {:9.3} µs per step, Gauss–Seidel sweeps {:.1} per step", best(&per_mortar), median(&per_mortar), sweeps(&c));
+    println!("  mortar / NTS        {:9.2} / {:9.2}  (goal ≤ 3)", best(&ratio), median(&ratio));
+    println!("  mortar contact part: integrals, search and set-up {:.1} µs, warm start {:.1} µs, sweeps {:.1} µs, record {:.1} µs per step", per_step(parts.search), per_step(parts.prepare), per_step(parts.sweeps), per_step(parts.record));
+    let json = serde_json::json!({
+        "n": n, "nodes": mortar.model.n_nodes(), "elements": mortar.model.n_elements(), "steps_per_repeat": steps, "repeats": repeats,
+        "pairs_nts": pairs_nts, "pairs_mortar": pairs_mortar, "per_pair_nts_us": per_nts, "per_pair_mortar_us": per_mortar, "ratio": ratio,
+        "sweeps_nts": sweeps(&b), "sweeps_mortar": sweeps(&c),
+    });
+    let _ = std::fs::write("target/bench/contact_mortar.json", serde_json::to_string_pretty(&json).unwrap());
 }

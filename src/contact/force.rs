@@ -39,11 +39,112 @@
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force_with_inverse, penalty_force, JointLaw, PairHistory, PairState};
 pub use super::state::{ContactState, JointRecord, PairRecord, SearchEvents};
+use super::mortar::{overlap_integrals, SlaveFace};
 use super::query::{project_along_on_quad_from, project_along_on_tri, select_projection, Location, INSIDE_TOL_DEFAULT};
 use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
 use crate::model::Model;
 use nalgebra::{Matrix3, Vector2, Vector3};
+
+/// The master side of one pair: up to four master nodes (`nm` used) with their weights `N_I`,
+/// and the master face (−1 for NTN).
+#[derive(Clone, Copy, Debug)]
+struct PairMasters<const M: usize = 4> {
+    nodes: [u32; M],
+    nm: u8,
+    weights: [f64; M],
+    face: i32,
+}
+
+/// A pair's mobility (module doc): the scalar `w` [1/kg], the inverse masses of its slave
+/// (`ims`) and masters (`imm`), whether it has a partly fixed or block node, and per node its
+/// free components (1 free, 0 fixed; all 1 unless partly fixed).
+#[derive(Clone, Copy, Debug)]
+struct Mobility<const N: usize = 5> {
+    w: f64,
+    ims: f64,
+    imm: [f64; N],
+    partial: bool,
+    masks: [Vector3<f64>; N],
+}
+
+/// Entries of a mortar pair: its slave node and at most 32 master nodes. A slave node's dual
+/// function couples it to the master nodes of every master face that overlaps one of its slave
+/// faces: 16 on two shifted structured quad grids, about 20 for triangles on quads or a slave
+/// a third coarser than its master; more means a slave side far coarser than the master
+/// (an error that says so). 33 entries keep a mortar pair at about 0.8 kB.
+const MORTAR_NODES: usize = 33;
+const MORTAR_MASTERS: usize = MORTAR_NODES - 1;
+
+/// A slave node's mortar pair is formed only when its weighted area `D_jj` is at least this
+/// fraction of its tributary area `∫ N_j` (1 on a fully covered node): 0.25. Below it the node
+/// is near the master's free edge with most of its slave faces uncovered, and the master weights
+/// `M_jk / D_jj` (which sum to one) grow as 1 / D_jj; such a node is counted lost that step
+/// (`SearchEvents::lost`), as an NTS node off the master is.
+const MORTAR_MIN_COVER: f64 = 0.25;
+
+/// The mortar pairs of the current step and the scratch of their integrals, apart from the
+/// node-to-segment pairs because a mortar slave node has more master nodes than a face's four.
+#[derive(Default)]
+struct MortarScratch {
+    active: Vec<Active<MORTAR_NODES>>,
+    mob_matrix: Vec<[Matrix3<f64>; MORTAR_NODES]>,
+    /// The Gauss–Seidel order (the order of the search) and the tick of each pair's last
+    /// evaluation.
+    order: Vec<u32>,
+    evaluated_at: Vec<u32>,
+    /// Per slave node of the joint being searched: `D_jj` [m²] and its master entries
+    /// (master-local node, `M_jk` [m²]; `count` used).
+    d: Vec<f64>,
+    rows: Vec<([u32; MORTAR_MASTERS], [f64; MORTAR_MASTERS], u8)>,
+    /// Candidate master faces of one slave face.
+    cand: Vec<u32>,
+}
+
+/// Slave node `i` found no master face this step: counted lost, force-free.
+fn lose_pair(rec: &mut JointRecord, i: usize) {
+    rec.events.lost += 1;
+    let p = &mut rec.pairs[i];
+    p.face = -1;
+    p.gap = f64::NAN;
+    p.r_n = 0.0;
+    p.r_t = [0.0; 2];
+    p.state = PairState::Open;
+}
+
+/// Slave node `i`'s pair is not formed (`joint::unformed_pairs`: the tie fixes the node):
+/// reported bonded, with no force of its own.
+fn unform_pair(rec: &mut JointRecord, i: usize) {
+    let p = &mut rec.pairs[i];
+    p.state = PairState::Bonded;
+    p.r_n = 0.0;
+    p.r_t = [0.0; 2];
+}
+
+/// The master side of slave node `i` projected at `p` on master face `f`; with `widen`, the
+/// node's candidate set is recentred on the face node it is nearest to (`report` keeps the
+/// initial set, by definition).
+fn masters_on_face(j: &ContactJoint, rec: &mut JointRecord, i: usize, f: usize, p: &super::query::Projection) -> PairMasters {
+    let local = j.tag.master.faces[f].local_nodes();
+    let (mut best, mut wmax) = (local[0], f64::MIN);
+    for (a, &l) in local.iter().enumerate() {
+        if p.weights[a] > wmax {
+            wmax = p.weights[a];
+            best = l;
+        }
+    }
+    if j.on_exit == OnExit::Widen && rec.pairs[i].center != best {
+        rec.pairs[i].center = best;
+        rec.events.recentred += 1;
+    }
+    let nodes = j.tag.master.faces[f].nodes();
+    let mut ms = [0u32; 4];
+    for (a, &nd) in nodes.iter().enumerate() {
+        ms[a] = nd;
+    }
+    rec.pairs[i].xi = p.xi;
+    PairMasters { nodes: ms, nm: nodes.len() as u8, weights: p.weights, face: f as i32 }
+}
 
 /// Per model node: where it is among the nodes of this step's active pairs.
 #[derive(Clone, Copy, Debug, Default)]
@@ -77,7 +178,7 @@ struct LocalNode {
 
 /// One active pair of the current step (scratch).
 #[derive(Clone, Copy, Debug)]
-struct Active {
+struct Active<const N: usize = 5> {
     joint: u32,
     pair: u32,
     nm: u8,
@@ -104,9 +205,9 @@ struct Active {
     /// 0 at a fixed node). Always five
     /// entries, so that the Gauss–Seidel update has no loop bounds to test: entries past the
     /// masters repeat the slave with coefficient and mobility 0.
-    nodes: [u32; 5],
-    coef: [f64; 5],
-    mob: [f64; 5],
+    nodes: [u32; N],
+    coef: [f64; N],
+    mob: [f64; N],
     /// The largest mob² of the five (a full sweep's test of whether the pair moved a node).
     mob2_max: f64,
     /// A pair with a partly fixed node or a node with an inertia block: its nodes move by
@@ -114,17 +215,24 @@ struct Active {
     /// inverse), not by `mob` (module doc, "Partly fixed nodes"; docs/contact.md, "Mobility of
     /// an anisotropic mass").
     partial: bool,
-    /// The same five nodes as indices into the solver's local nodes ([`LocalNode`]).
-    local: [u32; 5],
+    /// The same nodes as indices into the solver's local nodes ([`LocalNode`]).
+    local: [u32; N],
 }
 
-impl Active {
+impl<const N: usize> Active<N> {
+    /// The entries in use: all five of a node-to-segment pair (a constant, so that its loops
+    /// have fixed bounds), the slave and its `nm` masters of a mortar pair.
+    #[inline(always)]
+    fn span(&self) -> usize {
+        if N == 5 { 5 } else { self.nm as usize + 1 }
+    }
+
     /// The pair's relative displacement Σ N_I x_I − x_s over the local nodes (five terms
     /// always: unused entries have coefficient 0).
     #[inline(always)]
     fn relative_displacement(&self, local: &[LocalNode]) -> Vector3<f64> {
         let mut rel = Vector3::zeros();
-        for b in 0..5 {
+        for b in 0..self.span() {
             rel += local[self.local[b] as usize].x * self.coef[b];
         }
         rel
@@ -134,13 +242,13 @@ impl Active {
     /// over one step (`mob`: 0 at a fixed node or an unused entry; `masked`: this pair's
     /// per-component mobilities when it has a partly fixed node).
     #[inline(always)]
-    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>, matrix: &[[Matrix3<f64>; 5]], k: usize) {
+    fn move_nodes_into(&self, local: &mut [LocalNode], r: &Vector3<f64>, matrix: &[[Matrix3<f64>; N]], k: usize) {
         if self.partial {
-            for b in 0..5 {
+            for b in 0..self.span() {
                 local[self.local[b] as usize].x += matrix[k][b] * r;
             }
         } else {
-            for b in 0..5 {
+            for b in 0..self.span() {
                 local[self.local[b] as usize].x += r * self.mob[b];
             }
         }
@@ -206,6 +314,8 @@ pub struct ContactSolver<'m> {
     /// Per active pair when `partial` is not empty (else empty): its nodes' mobilities per
     /// component (`mob` times each node's free components, 1 or 0).
     mob_matrix: Vec<[Matrix3<f64>; 5]>,
+    /// The mortar pairs (`Method::Mortar`) and their scratch.
+    mortar: MortarScratch,
     /// The free nodes with a 3×3 inertia block, ascending (empty for most models).
     block_nodes: Vec<u32>,
     /// Per joint and slave node, whether its pair is not formed (`joint::unformed_pairs`: the
@@ -244,7 +354,7 @@ impl<'m> ContactSolver<'m> {
         }
         let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
-        ContactSolver { block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Whether `node` is partly fixed (and moves on its free components only).
@@ -514,7 +624,7 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
 /// loop rather than a test per pair, so that the full pass carries nothing of the list.
 #[inline(never)] // its own code, whatever the code around it (a sweep is long; one call per sweep)
 #[allow(clippy::too_many_arguments)]
-fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]]) -> usize {
+fn sweep_pass<const LISTED: bool, const N: usize>(active: &mut [Active<N>], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; N]]) -> usize {
     let mut moving = 0;
     for &k in order.iter() {
         let k = k as usize;
@@ -530,17 +640,17 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
             // a pair with a partly fixed node repeats its update (its scalar mobility is an
             // upper bound of its directions', so one update may leave part of its own
             // residual: `PARTIAL_PAIR_UPDATES`), until an update moves no node
-            let moved = update_pair::<LISTED, true>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix);
+            let moved = update_pair::<LISTED, true, N>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix);
             moving += moved as usize;
             if moved {
                 for _ in 1..PARTIAL_PAIR_UPDATES {
-                    if !update_pair::<LISTED, true>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) {
+                    if !update_pair::<LISTED, true, N>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) {
                         break;
                     }
                 }
             }
         } else {
-            moving += update_pair::<LISTED, false>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) as usize;
+            moving += update_pair::<LISTED, false, N>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) as usize;
         }
     }
     if LISTED { 0 } else { moving }
@@ -553,7 +663,7 @@ fn sweep_pass<const LISTED: bool>(active: &mut [Active], order: &[u32], local: &
 /// update moved a node by more than the marking tolerance.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn update_pair<const LISTED: bool, const PARTIAL: bool>(a: &mut Active, k: usize, local: &mut [LocalNode], clock: u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]]) -> bool {
+fn update_pair<const LISTED: bool, const PARTIAL: bool, const N: usize>(a: &mut Active<N>, k: usize, local: &mut [LocalNode], clock: u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; N]]) -> bool {
     let [n, t1, t2] = a.frame;
     // current relative quantities with all forces applied so far
     let rel = a.relative_displacement(local);
@@ -573,7 +683,7 @@ fn update_pair<const LISTED: bool, const PARTIAL: bool>(a: &mut Active, k: usize
     // |du|² = |dr|² mob²: one norm per pair instead of one per node
     let dr2 = dr.norm_squared();
     if LISTED {
-        for b in 0..5 {
+        for b in 0..a.span() {
             let l = &mut local[a.local[b] as usize];
             l.moved_at = l.moved_at.max(clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
             if PARTIAL {
@@ -583,11 +693,11 @@ fn update_pair<const LISTED: bool, const PARTIAL: bool>(a: &mut Active, k: usize
             }
         }
     } else if PARTIAL {
-        for b in 0..5 {
+        for b in 0..a.span() {
             local[a.local[b] as usize].x += mob_matrix[k][b] * dr;
         }
     } else {
-        for b in 0..5 {
+        for b in 0..a.span() {
             local[a.local[b] as usize].x += dr * a.mob[b];
         }
     }
@@ -601,8 +711,8 @@ fn update_pair<const LISTED: bool, const PARTIAL: bool>(a: &mut Active, k: usize
 
 /// Whether active pair `a`, last evaluated at tick `since`, has a node moved after it.
 #[inline(always)]
-fn moved_since(local: &[LocalNode], a: &Active, since: u32) -> bool {
-    a.local.iter().fold(0, |m, &l| m.max(local[l as usize].moved_at)) > since
+fn moved_since<const N: usize>(local: &[LocalNode], a: &Active<N>, since: u32) -> bool {
+    a.local[..a.span()].iter().fold(0, |m, &l| m.max(local[l as usize].moved_at)) > since
 }
 
 impl ContactSolver<'_> {
@@ -610,293 +720,439 @@ impl ContactSolver<'_> {
     /// `u_next` (or on `u` for a penalty joint), the active list of the dynamic-force pairs,
     /// and the penalty forces of step n applied to the prediction. Returns the penalty work [J].
     #[inline(never)] // out of line, so that profiles show the four parts of a step
-    fn search_into(&mut self, model: &Model, history: &mut ContactState, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> f64 {
+    fn search_into(&mut self, model: &Model, history: &mut ContactState, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &mut [f64]) -> Result<f64, StepError> {
         self.active.clear();
         self.mob_matrix.clear();
+        self.mortar.active.clear();
+        self.mortar.mob_matrix.clear();
         self.penalty.clear();
-        let mut penalty_work = 0.0;
-        // ---------------------------------------------------------------- search
-        for (ji, j) in self.joints.iter().enumerate() {
+        let joints = self.joints;
+        for (ji, j) in joints.iter().enumerate() {
             let rec = &mut history.joints[ji];
+            if j.method == Method::Mortar {
+                self.mortar_search_into(model, j, ji, rec, dt2, u, u_next)?;
+                continue;
+            }
             let penalty = matches!(j.method, Method::Penalty { .. });
             // penalty works on the configuration at t[n]; the dynamic force on the prediction
             let conf: &[f64] = if penalty { u } else { u_next };
             for i in 0..j.tag.n_slave() {
                 let s = j.tag.slave_nodes()[i];
-                let [n, t1, t2] = j.frames[i];
                 let xs = pos(model, conf, s);
-                let pr = rec.pairs[i];
-                let (masters, nm, weights, face) = match j.method {
-                    Method::Ntn => {
-                        let o = j.tag.nearest_master_node(i) as u32;
-                        ([o, 0, 0, 0], 1u8, [1.0, 0.0, 0.0, 0.0], -1i32)
-                    }
-                    _ => {
-                        // Temporal coherence: a node still strictly inside the face it was on at
-                        // the last step, and near it along its normal (within half the face
-                        // size, so that no other sheet of a folded master can be nearer), keeps
-                        // that face: the full search would choose it too (selection rules of
-                        // `select_projection`: nearest sheet, inside before edge, face id).
-                        let mut found = None;
-                        if pr.face >= 0 && j.law.tied {
-                            // A tied pair keeps the face it was tied to (a tie is made once and
-                            // kept, as tied contact does in LS-DYNA or Abaqus): the node is
-                            // projected on that face whatever its location (no inside test), so
-                            // a bonded node that a shear force carries dt² F / m past the face's
-                            // edge in the prediction is not lost (regression:
-                            // `tied_pure_shear_keeps_perimeter_nodes_at_the_default_edge_tolerance`).
-                            let f = pr.face as usize;
-                            found = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
-                        } else if pr.face >= 0 {
-                            let f = pr.face as usize;
-                            if let Some((p, edge2)) = project_on_face(model, j, f, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
-                                && p.location == Location::Inside
-                                && p.t * p.t <= 0.25 * edge2
-                            {
-                                found = Some((f, p));
-                            }
+                let pm = match j.method {
+                    Method::Ntn => PairMasters { nodes: [j.tag.nearest_master_node(i) as u32, 0, 0, 0], nm: 1, weights: [1.0, 0.0, 0.0, 0.0], face: -1 },
+                    _ => match self.nts_face_into(model, j, rec, i, &xs, conf) {
+                        Some((f, p)) => masters_on_face(j, rec, i, f, &p),
+                        None => {
+                            lose_pair(rec, i);
+                            continue;
                         }
-                        if found.is_none() {
-                            self.candidates_into(j, pr.center, j.layer);
-                            let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
-                            self.cand = cand;
-                        }
-                        if found.is_none() {
-                            // a node just off the master's free edge (see `edge_tolerance`)
-                            let cand = std::mem::take(&mut self.cand);
-                            found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, j.edge_tolerance);
-                            self.cand = cand;
-                            if found.is_some() {
-                                rec.events.perimeter_kept += 1;
-                            }
-                        }
-                        if found.is_none() && j.on_exit == OnExit::Widen {
-                            if j.layer < 2 {
-                                self.candidates_into(j, pr.center, 2);
-                                let cand = std::mem::take(&mut self.cand);
-                                found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
-                                self.cand = cand;
-                                if found.is_some() {
-                                    rec.events.widened_layer2 += 1;
-                                }
-                            }
-                            if found.is_none() {
-                                // walk the master surface to the node nearest the slave's position
-                                let m = &j.tag.master;
-                                let mut c = pr.center as usize;
-                                let d = |l: usize| (pos(model, conf, m.nodes[l]) - xs).norm_squared();
-                                loop {
-                                    let mut best = (d(c), c);
-                                    for &f in m.faces_of_node(c) {
-                                        for &v in m.faces[f as usize].local_nodes() {
-                                            let dv = d(v as usize);
-                                            if dv < best.0 || (dv == best.0 && (v as usize) < best.1) {
-                                                best = (dv, v as usize);
-                                            }
-                                        }
-                                    }
-                                    if best.1 == c {
-                                        break;
-                                    }
-                                    c = best.1;
-                                }
-                                rec.events.fresh_searches += 1;
-                                rec.pairs[i].center = c as u32;
-                                // Layer2 around the new centre; around the old one it was just
-                                // tried (above, or as the joint's own layer), with the same
-                                // result: a node that stays lost (outside the master, next to
-                                // its edge) costs one Layer2 search a step, not two
-                                if c != pr.center as usize {
-                                    self.candidates_into(j, c as u32, 2);
-                                    let cand = std::mem::take(&mut self.cand);
-                                    found = project_on(model, j, &cand, &xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT);
-                                    self.cand = cand;
-                                }
-                            }
-                        }
-                        match found {
-                            Some((f, p)) => {
-                                // `widen`: keep the candidate set centred on the node the slave is
-                                // nearest to (`report` keeps the initial set, by definition)
-                                let local = j.tag.master.faces[f].local_nodes();
-                                let (mut best, mut wmax) = (local[0], f64::MIN);
-                                for (a, &l) in local.iter().enumerate() {
-                                    if p.weights[a] > wmax {
-                                        wmax = p.weights[a];
-                                        best = l;
-                                    }
-                                }
-                                if j.on_exit == OnExit::Widen && rec.pairs[i].center != best {
-                                    rec.pairs[i].center = best;
-                                    rec.events.recentred += 1;
-                                }
-                                let nodes = j.tag.master.faces[f].nodes();
-                                let mut ms = [0u32; 4];
-                                for (a, &nd) in nodes.iter().enumerate() {
-                                    ms[a] = nd;
-                                }
-                                rec.pairs[i].xi = p.xi;
-                                (ms, nodes.len() as u8, p.weights, f as i32)
-                            }
-                            None => {
-                                rec.events.lost += 1;
-                                let p = &mut rec.pairs[i];
-                                p.face = -1;
-                                p.gap = f64::NAN;
-                                p.r_n = 0.0;
-                                p.r_t = [0.0; 2];
-                                p.state = PairState::Open;
-                                continue;
-                            }
-                        }
-                    }
+                    },
                 };
                 // A pair whose slave node is the slave of a (later) tied joint is not formed
                 // (`joint::unformed_pairs`: the tie fixes the node): reported bonded, with no
                 // force of its own.
                 if self.unformed[ji][i] {
-                    let p = &mut rec.pairs[i];
-                    p.state = PairState::Bonded;
-                    p.r_n = 0.0;
-                    p.r_t = [0.0; 2];
+                    unform_pair(rec, i);
                     continue;
                 }
-                let ims = self.inv_mass[s];
-                let mut imm = [0.0; 4];
-                let mut w = ims;
-                for a in 0..nm as usize {
-                    imm[a] = self.inv_mass[masters[a] as usize];
-                    w += weights[a] * weights[a] * imm[a];
-                }
-                // a partly fixed node in the pair: the mobility per component, W = Σ c² P / m
-                // (diagonal); the update's scalar is its largest entry (module doc)
-                let partly_fixed = !self.partial.is_empty() && (self.is_partial(s as u32) || masters[..nm as usize].iter().any(|&m| self.is_partial(m)));
-                let is_block = |nd: u32| !self.block_nodes.is_empty() && self.block_nodes.binary_search(&nd).is_ok();
-                let on_block = is_block(s as u32) || masters[..nm as usize].iter().any(|&m| is_block(m));
-                let mut masks = [Vector3::repeat(1.0); 5];
-                if partly_fixed {
-                    masks[0] = free_mask(model, s);
-                    let mut wv = masks[0] * ims;
-                    for a in 0..nm as usize {
-                        masks[a + 1] = free_mask(model, masters[a] as usize);
-                        wv += masks[a + 1] * (weights[a] * weights[a] * imm[a]);
-                    }
-                    if wv.dot(&n.component_mul(&n)) == 0.0 {
-                        // no node of the pair can move along its normal: no contact force
-                        continue;
-                    }
-                    w = wv.max();
-                }
-                if w == 0.0 {
-                    continue;
-                }
+                let Some(mobility) = self.pair_mobility(model, s, &j.frames[i][0], &pm) else { continue };
                 if let Method::Penalty { kn, kt } = j.method {
-                    // current gap and relative displacement on the configuration at t[n]
-                    let mut xbar = Vector3::zeros();
-                    let mut um_n = Vector3::zeros();
-                    for a in 0..nm as usize {
-                        let mi = masters[a] as usize;
-                        xbar += pos(model, conf, mi) * weights[a];
-                        um_n += disp(u, mi) * weights[a];
-                    }
-                    let gap = n.dot(&(xbar - xs)) - rec.pairs[i].gap_offset;
-                    // explicit penalty at t[n]: tangential increment over the last step
-                    let mut um_p = Vector3::zeros();
-                    for a in 0..nm as usize {
-                        um_p += disp(u_prev, masters[a] as usize) * weights[a];
-                    }
-                    let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
-                    let area = j.tag.areas[i];
-                    let p = &mut rec.pairs[i];
-                    let ddt = Vector2::new(dd.dot(&t1), dd.dot(&t2));
-                    let resp = penalty_force(&self.law_in_force(j), &p.hist, gap, Vector2::new(p.r_t[0], p.r_t[1]), ddt, kn * area, kt * area, area);
-                    p.hist = resp.hist;
-                    let (r_n, r_t, state) = (resp.r_n, resp.r_t, resp.state);
-                    let rvec = -n * r_n + t1 * r_t.x + t2 * r_t.y;
-                    p.d_t[0] += dd.dot(&t1);
-                    p.d_t[1] += dd.dot(&t2);
-                    p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
-                    p.gap = gap;
-                    p.face = face;
-                    p.r_n = r_n;
-                    p.r_t = [r_t.x, r_t.y];
-                    p.state = state;
-                    self.penalty.push((s as u32, masters, nm, weights, rvec));
-                    continue;
+                    self.penalty_pair_into(model, j, rec, i, &pm, (kn, kt), &xs, u_prev, u);
+                } else {
+                    self.active_pair_into(model, j, ji, rec, i, &pm, &mobility, dt2, u);
                 }
-                let warm = self.gs_warm_start && pr.state != PairState::Open;
-                let mut xbar0 = -Vector3::from(model.mesh.nodes[s]);
-                let mut rel_u = -disp(u, s);
-                for a in 0..nm as usize {
-                    let mi = masters[a] as usize;
-                    xbar0 += Vector3::from(model.mesh.nodes[mi]) * weights[a];
-                    rel_u += disp(u, mi) * weights[a];
-                }
-                let mut nodes5 = [s as u32; 5];
-                let mut coef = [-1.0, 0.0, 0.0, 0.0, 0.0];
-                let mut mob = [0.0; 5];
-                if ims > 0.0 {
-                    mob[0] = dt2 * ims;
-                }
-                for b in 0..nm as usize {
-                    nodes5[b + 1] = masters[b];
-                    coef[b + 1] = weights[b];
-                    let imi = imm[b];
-                    if imi > 0.0 {
-                        mob[b + 1] = -dt2 * weights[b] * imi;
-                    }
-                }
-                if !self.partial.is_empty() || !self.block_nodes.is_empty() {
-                    // one entry per active pair (indexed like `active`), read when `partial`:
-                    // the displacement a unit pair force gives each node, mob × its free
-                    // components, or at a node with an inertia block ±dt² N M⁻¹ (the block's
-                    // inverse, restricted to the free components; docs/contact.md, "Mobility
-                    // of an anisotropic mass")
-                    let nodes_b = nodes5;
-                    self.mob_matrix.push(std::array::from_fn(|b| match model.mass.block_of(nodes_b[b] as usize) {
-                        Some(blk) if b <= nm as usize && self.inv_mass[nodes_b[b] as usize] > 0.0 => blk.inverse * (mob[b] / self.inv_mass[nodes_b[b] as usize]),
-                        _ => Matrix3::from_diagonal(&masks[b]) * mob[b],
-                    }));
-                }
-                self.active.push(Active {
-                    nodes: nodes5,
-                    local: [0; 5],
-                    partial: partly_fixed || on_block,
-                    mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
-                    coef,
-                    mob,
-                    frame: j.frames[i],
-                    area: j.tag.areas[i],
-                    hist0: pr.hist,
-                    // the grouted gap counts as closed (0 unless grouted)
-                    gap0: n.dot(&xbar0) - pr.gap_offset,
-                    rel_u,
-                    joint: ji as u32,
-                    pair: i as u32,
-                    nm,
-                    dt2w: dt2 * w,
-                    inv_dt2w: 1.0 / (dt2 * w),
-                    // warm start: a pair in contact at the last step starts from its last force
-                    r_n: if warm { pr.r_n } else { 0.0 },
-                    r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
-                    hist: pr.hist,
-                    state: PairState::Open,
-                    // set by the first sweep, which evaluates every pair
-                    gap: f64::NAN,
-                });
-                rec.pairs[i].face = face;
             }
         }
+        Ok(self.apply_penalty_into(model, dt2, u_prev, u_next))
+    }
 
-        // penalty forces of step n act like external forces on the prediction
+    /// The mortar pairs of joint `j` (`Method::Mortar`) on the prediction `u_next`
+    /// (docs/contact.md, "Dual mortar"): the mortar integrals of every slave face with the master
+    /// faces of its candidate set (Layer2 around the centres of its nodes), evaluated every step
+    /// on the predicted positions, so that the overlaps follow the faces as they slide; summed per
+    /// slave node into `D_jj` and `M_jk`; then one pair per slave node whose master is
+    /// `Σ_k (M_jk / D_jj) x_k`, forced as a node-to-segment pair is. Each node's centre follows
+    /// the master node of its largest weight.
+    #[allow(clippy::too_many_arguments)]
+    fn mortar_search_into(&mut self, model: &Model, j: &ContactJoint, ji: usize, rec: &mut JointRecord, dt2: f64, u: &[f64], u_next: &[f64]) -> Result<(), StepError> {
+        let n_s = j.tag.n_slave();
+        let mut d = std::mem::take(&mut self.mortar.d);
+        let mut rows = std::mem::take(&mut self.mortar.rows);
+        d.clear();
+        d.resize(n_s, 0.0);
+        rows.clear();
+        rows.resize(n_s, ([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0));
+        let overflow = self.mortar_integrals_into(model, j, rec, u_next, &mut d, &mut rows);
+        if let Some(i) = overflow {
+            return Err(StepError::Contact(format!(
+                "joint \"{}\" (mortar): slave node {} couples to more than {MORTAR_MASTERS} master nodes: the slave side is far coarser than the master. Make the finer side the slave (`auto`, or swap `master` and `slave`) or refine the slave side",
+                j.tag.name,
+                j.tag.slave_nodes()[i]
+            )));
+        }
+        let ms = &j.tag.master;
+        for i in 0..n_s {
+            if self.unformed[ji][i] {
+                unform_pair(rec, i);
+                continue;
+            }
+            let (ml, mv, cnt) = rows[i];
+            if !(d[i] >= MORTAR_MIN_COVER * j.tag.areas[i]) {
+                lose_pair(rec, i);
+                continue;
+            }
+            let mut pm = PairMasters::<MORTAR_MASTERS> { nodes: [0; MORTAR_MASTERS], nm: cnt, weights: [0.0; MORTAR_MASTERS], face: -1 };
+            let mut best = (f64::MIN, 0u32);
+            for k in 0..cnt as usize {
+                pm.nodes[k] = ms.nodes[ml[k] as usize] as u32;
+                pm.weights[k] = mv[k] / d[i];
+                if pm.weights[k] > best.0 {
+                    best = (pm.weights[k], ml[k]);
+                }
+            }
+            if rec.pairs[i].center != best.1 {
+                rec.pairs[i].center = best.1;
+                rec.events.recentred += 1;
+            }
+            // the face reported for the pair: a master face at its centre
+            pm.face = ms.faces_of_node(best.1 as usize).first().map_or(-1, |&f| f as i32);
+            let s = j.tag.slave_nodes()[i];
+            let Some(mobility) = self.pair_mobility::<MORTAR_MASTERS, MORTAR_NODES>(model, s, &j.frames[i][0], &pm) else { continue };
+            let (a, matrix) = self.active_pair(model, j, ji, &rec.pairs[i], i, &pm, &mobility, dt2, u, d[i]);
+            self.mortar.active.push(a);
+            self.mortar.mob_matrix.extend(matrix);
+            rec.pairs[i].face = pm.face;
+        }
+        self.mortar.d = d;
+        self.mortar.rows = rows;
+        Ok(())
+    }
+
+    /// The mortar integrals of joint `j` at the positions `u_next`, summed per slave node: `d[i]`
+    /// = `D_jj` and `rows[i]` its master-local nodes with `M_jk` [m²]. Returns a slave node with
+    /// more than `MORTAR_MASTERS` master nodes, if any.
+    fn mortar_integrals_into(&mut self, model: &Model, j: &ContactJoint, rec: &JointRecord, u_next: &[f64], d: &mut [f64], rows: &mut [([u32; MORTAR_MASTERS], [f64; MORTAR_MASTERS], u8)]) -> Option<usize> {
+        let mut cand = std::mem::take(&mut self.mortar.cand);
+        let mut overflow = None;
+        let (sl, ms) = (&j.tag.slave, &j.tag.master);
+        for face in &sl.faces {
+            let nodes = face.nodes();
+            let mut x = [Vector3::zeros(); 4];
+            for (a, &nd) in nodes.iter().enumerate() {
+                x[a] = pos(model, u_next, nd as usize);
+            }
+            let Some(sf) = SlaveFace::new(&x[..nodes.len()]) else { continue };
+            cand.clear();
+            for &l in face.local_nodes() {
+                self.candidates_into(j, rec.pairs[l as usize].center, 2);
+                cand.extend_from_slice(&self.cand);
+            }
+            cand.sort_unstable();
+            cand.dedup();
+            for &mf in &cand {
+                let (xm, km) = face_positions(model, j, mf as usize, u_next);
+                let Some(o) = overlap_integrals(&sf, &xm[..km]) else { continue };
+                for (a, &l) in face.local_nodes().iter().enumerate() {
+                    let l = l as usize;
+                    d[l] += o.d[a];
+                    let row = &mut rows[l];
+                    for (b, &ml) in ms.faces[mf as usize].local_nodes().iter().enumerate() {
+                        let cnt = row.2 as usize;
+                        match row.0[..cnt].iter().position(|&x| x == ml) {
+                            Some(p) => row.1[p] += o.m[a][b],
+                            None if cnt < MORTAR_MASTERS => {
+                                row.0[cnt] = ml;
+                                row.1[cnt] = o.m[a][b];
+                                row.2 += 1;
+                            }
+                            None => overflow = Some(l),
+                        }
+                    }
+                }
+            }
+        }
+        self.mortar.cand = cand;
+        overflow
+    }
+
+    /// The master face of slave node `i` of joint `j` (node-to-segment search on `conf`): the
+    /// face of the last step when the node is still inside it, else its candidate set, the
+    /// master's free edge within `edge_tolerance`, and with `widen` Layer2 and a fresh
+    /// nearest-node search (module doc). `None`: the node found no face.
+    fn nts_face_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
+        let n = j.frames[i][0];
+        let pr = rec.pairs[i];
+        // Temporal coherence: a node still strictly inside the face it was on at
+        // the last step, and near it along its normal (within half the face
+        // size, so that no other sheet of a folded master can be nearer), keeps
+        // that face: the full search would choose it too (selection rules of
+        // `select_projection`: nearest sheet, inside before edge, face id).
+        let mut found = None;
+        if pr.face >= 0 && j.law.tied {
+            // A tied pair keeps the face it was tied to (a tie is made once and
+            // kept, as tied contact does in LS-DYNA or Abaqus): the node is
+            // projected on that face whatever its location (no inside test), so
+            // a bonded node that a shear force carries dt² F / m past the face's
+            // edge in the prediction is not lost (regression:
+            // `tied_pure_shear_keeps_perimeter_nodes_at_the_default_edge_tolerance`).
+            let f = pr.face as usize;
+            found = project_on_face(model, j, f, xs, &n, conf, &mut rec.events.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
+        } else if pr.face >= 0 {
+            let f = pr.face as usize;
+            if let Some((p, edge2)) = project_on_face(model, j, f, xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
+                && p.location == Location::Inside
+                && p.t * p.t <= 0.25 * edge2
+            {
+                found = Some((f, p));
+            }
+        }
+        if found.is_none() {
+            self.candidates_into(j, pr.center, j.layer);
+            found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+        }
+        if found.is_none() {
+            // a node just off the master's free edge (see `edge_tolerance`)
+            found = self.project_on_candidates(model, j, rec, xs, &n, conf, j.edge_tolerance);
+            if found.is_some() {
+                rec.events.perimeter_kept += 1;
+            }
+        }
+        if found.is_none() && j.on_exit == OnExit::Widen {
+            found = self.widen_into(model, j, rec, i, xs, conf);
+        }
+        found
+    }
+
+    /// Project on the candidate faces in `cand` (tolerance `tol`).
+    #[allow(clippy::too_many_arguments)]
+    fn project_on_candidates(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, xs: &Vector3<f64>, n: &Vector3<f64>, conf: &[f64], tol: f64) -> Option<(usize, super::query::Projection)> {
+        let cand = std::mem::take(&mut self.cand);
+        let found = project_on(model, j, &cand, xs, n, conf, &mut rec.events.projection_failures, tol);
+        self.cand = cand;
+        found
+    }
+
+    /// `widen` (slave node `i` left its candidate set): Layer2 around the centre, then a walk on
+    /// the master surface to the node nearest the slave's position, which becomes the centre.
+    fn widen_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
+        let n = j.frames[i][0];
+        let pr = rec.pairs[i];
+        let mut found = None;
+        if j.layer < 2 {
+            self.candidates_into(j, pr.center, 2);
+            found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+            if found.is_some() {
+                rec.events.widened_layer2 += 1;
+            }
+        }
+        if found.is_none() {
+            // walk the master surface to the node nearest the slave's position
+            let m = &j.tag.master;
+            let mut c = pr.center as usize;
+            let d = |l: usize| (pos(model, conf, m.nodes[l]) - xs).norm_squared();
+            loop {
+                let mut best = (d(c), c);
+                for &f in m.faces_of_node(c) {
+                    for &v in m.faces[f as usize].local_nodes() {
+                        let dv = d(v as usize);
+                        if dv < best.0 || (dv == best.0 && (v as usize) < best.1) {
+                            best = (dv, v as usize);
+                        }
+                    }
+                }
+                if best.1 == c {
+                    break;
+                }
+                c = best.1;
+            }
+            rec.events.fresh_searches += 1;
+            rec.pairs[i].center = c as u32;
+            // Layer2 around the new centre; around the old one it was just
+            // tried (above, or as the joint's own layer), with the same
+            // result: a node that stays lost (outside the master, next to
+            // its edge) costs one Layer2 search a step, not two
+            if c != pr.center as usize {
+                self.candidates_into(j, c as u32, 2);
+                found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+            }
+        }
+        found
+    }
+
+    /// The pair's mobility (module doc): `None` when the pair can take no force (no node of it
+    /// moves along its normal).
+    fn pair_mobility<const M: usize, const N: usize>(&self, model: &Model, s: usize, n: &Vector3<f64>, pm: &PairMasters<M>) -> Option<Mobility<N>> {
+        let (masters, nm, weights) = (&pm.nodes, pm.nm, &pm.weights);
+        let ims = self.inv_mass[s];
+        let mut imm = [0.0; N];
+        let mut w = ims;
+        for a in 0..nm as usize {
+            imm[a] = self.inv_mass[masters[a] as usize];
+            w += weights[a] * weights[a] * imm[a];
+        }
+        // a partly fixed node in the pair: the mobility per component, W = Σ c² P / m
+        // (diagonal); the update's scalar is its largest entry (module doc)
+        let partly_fixed = !self.partial.is_empty() && (self.is_partial(s as u32) || masters[..nm as usize].iter().any(|&m| self.is_partial(m)));
+        let is_block = |nd: u32| !self.block_nodes.is_empty() && self.block_nodes.binary_search(&nd).is_ok();
+        let on_block = is_block(s as u32) || masters[..nm as usize].iter().any(|&m| is_block(m));
+        let mut masks = [Vector3::repeat(1.0); N];
+        if partly_fixed {
+            masks[0] = free_mask(model, s);
+            let mut wv = masks[0] * ims;
+            for a in 0..nm as usize {
+                masks[a + 1] = free_mask(model, masters[a] as usize);
+                wv += masks[a + 1] * (weights[a] * weights[a] * imm[a]);
+            }
+            if wv.dot(&n.component_mul(n)) == 0.0 {
+                // no node of the pair can move along its normal: no contact force
+                return None;
+            }
+            w = wv.max();
+        }
+        if w == 0.0 {
+            return None;
+        }
+        Some(Mobility { w, ims, imm, partial: partly_fixed || on_block, masks })
+    }
+
+    /// A penalty pair (`Method::Penalty`): its force of step n from the configuration at t[n],
+    /// recorded in the history and queued in `penalty` for the prediction.
+    #[allow(clippy::too_many_arguments)]
+    fn penalty_pair_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, pm: &PairMasters, (kn, kt): (f64, f64), xs: &Vector3<f64>, u_prev: &[f64], u: &[f64]) {
+        let (masters, nm, weights) = (pm.nodes, pm.nm, pm.weights);
+        let s = j.tag.slave_nodes()[i];
+        let [n, t1, t2] = j.frames[i];
+        // current gap and relative displacement on the configuration at t[n]
+        let mut xbar = Vector3::zeros();
+        let mut um_n = Vector3::zeros();
+        for a in 0..nm as usize {
+            let mi = masters[a] as usize;
+            xbar += pos(model, u, mi) * weights[a];
+            um_n += disp(u, mi) * weights[a];
+        }
+        let gap = n.dot(&(xbar - xs)) - rec.pairs[i].gap_offset;
+        // explicit penalty at t[n]: tangential increment over the last step
+        let mut um_p = Vector3::zeros();
+        for a in 0..nm as usize {
+            um_p += disp(u_prev, masters[a] as usize) * weights[a];
+        }
+        let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
+        let area = j.tag.areas[i];
+        let p = &mut rec.pairs[i];
+        let ddt = Vector2::new(dd.dot(&t1), dd.dot(&t2));
+        let resp = penalty_force(&self.law_in_force(j), &p.hist, gap, Vector2::new(p.r_t[0], p.r_t[1]), ddt, kn * area, kt * area, area);
+        p.hist = resp.hist;
+        let (r_n, r_t, state) = (resp.r_n, resp.r_t, resp.state);
+        let rvec = -n * r_n + t1 * r_t.x + t2 * r_t.y;
+        p.d_t[0] += dd.dot(&t1);
+        p.d_t[1] += dd.dot(&t2);
+        p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
+        p.gap = gap;
+        p.face = pm.face;
+        p.r_n = r_n;
+        p.r_t = [r_t.x, r_t.y];
+        p.state = state;
+        self.penalty.push((s as u32, masters, nm, weights, rvec));
+    }
+
+    /// A dynamic-force pair into the active list (`active`, and `mob_matrix` when the model has
+    /// partly fixed or block nodes), warm-started from its force of the last step.
+    #[allow(clippy::too_many_arguments)]
+    fn active_pair_into(&mut self, model: &Model, j: &ContactJoint, ji: usize, rec: &mut JointRecord, i: usize, pm: &PairMasters, mob_of: &Mobility, dt2: f64, u: &[f64]) {
+        let (a, matrix) = self.active_pair(model, j, ji, &rec.pairs[i], i, pm, mob_of, dt2, u, j.tag.areas[i]);
+        self.active.push(a);
+        self.mob_matrix.extend(matrix);
+        rec.pairs[i].face = pm.face;
+    }
+
+    /// A dynamic-force pair of slave node `i` (history `pr`) with the masters `pm`, its
+    /// mobility and its area `area` [m²] (the law's `A_s`), warm-started from its force of the
+    /// last step; with it, its mobility matrix when the model has partly fixed or block nodes
+    /// (`mob_matrix`).
+    #[allow(clippy::too_many_arguments)]
+    fn active_pair<const M: usize, const N: usize>(&self, model: &Model, j: &ContactJoint, ji: usize, pr: &PairRecord, i: usize, pm: &PairMasters<M>, mob_of: &Mobility<N>, dt2: f64, u: &[f64], area: f64) -> (Active<N>, Option<[Matrix3<f64>; N]>) {
+        debug_assert!(M + 1 == N);
+        let (masters, nm, weights) = (pm.nodes, pm.nm, pm.weights);
+        let s = j.tag.slave_nodes()[i];
+        let n = j.frames[i][0];
+        let warm = self.gs_warm_start && pr.state != PairState::Open;
+        let mut xbar0 = -Vector3::from(model.mesh.nodes[s]);
+        let mut rel_u = -disp(u, s);
+        for a in 0..nm as usize {
+            let mi = masters[a] as usize;
+            xbar0 += Vector3::from(model.mesh.nodes[mi]) * weights[a];
+            rel_u += disp(u, mi) * weights[a];
+        }
+        let mut nodes5 = [s as u32; N];
+        let mut coef = [0.0; N];
+        coef[0] = -1.0;
+        let mut mob = [0.0; N];
+        if mob_of.ims > 0.0 {
+            mob[0] = dt2 * mob_of.ims;
+        }
+        for b in 0..nm as usize {
+            nodes5[b + 1] = masters[b];
+            coef[b + 1] = weights[b];
+            let imi = mob_of.imm[b];
+            if imi > 0.0 {
+                mob[b + 1] = -dt2 * weights[b] * imi;
+            }
+        }
+        let matrix = (!self.partial.is_empty() || !self.block_nodes.is_empty()).then(|| {
+            // one entry per active pair (indexed like `active`), read when `partial`:
+            // the displacement a unit pair force gives each node, mob × its free
+            // components, or at a node with an inertia block ±dt² N M⁻¹ (the block's
+            // inverse, restricted to the free components; docs/contact.md, "Mobility
+            // of an anisotropic mass")
+            let nodes_b = nodes5;
+            let masks = mob_of.masks;
+            std::array::from_fn(|b| match model.mass.block_of(nodes_b[b] as usize) {
+                Some(blk) if b <= nm as usize && self.inv_mass[nodes_b[b] as usize] > 0.0 => blk.inverse * (mob[b] / self.inv_mass[nodes_b[b] as usize]),
+                _ => Matrix3::from_diagonal(&masks[b]) * mob[b],
+            })
+        });
+        let w = mob_of.w;
+        let a = Active {
+            nodes: nodes5,
+            local: [0; N],
+            partial: mob_of.partial,
+            mob2_max: mob.iter().fold(0.0, |m: f64, &v| if v * v > m { v * v } else { m }),
+            coef,
+            mob,
+            frame: j.frames[i],
+            area,
+            hist0: pr.hist,
+            // the grouted gap counts as closed (0 unless grouted)
+            gap0: n.dot(&xbar0) - pr.gap_offset,
+            rel_u,
+            joint: ji as u32,
+            pair: i as u32,
+            nm,
+            dt2w: dt2 * w,
+            inv_dt2w: 1.0 / (dt2 * w),
+            // warm start: a pair in contact at the last step starts from its last force
+            r_n: if warm { pr.r_n } else { 0.0 },
+            r_t: if warm { Vector2::new(pr.r_t[0], pr.r_t[1]) } else { Vector2::zeros() },
+            hist: pr.hist,
+            state: PairState::Open,
+            // set by the first sweep, which evaluates every pair
+            gap: f64::NAN,
+        };
+        (a, matrix)
+    }
+
+    /// The penalty forces of step n applied to the prediction like external forces; returns
+    /// their work over the step [J].
+    fn apply_penalty_into(&self, model: &Model, dt2: f64, u_prev: &[f64], u_next: &mut [f64]) -> f64 {
+        let mut penalty_work = 0.0;
         for &(s, masters, nm, weights, rvec) in &self.penalty {
             add_pair_force_into(u_next, &self.inv_mass, dt2, s, &masters[..nm as usize], &weights, &rvec);
             if !self.block_nodes.is_empty() {
                 // a penalty force is an external force: at a block node its displacement is
                 // dt² M⁻¹ R with the full inverse, not the scalar of `inv_mass`
                 let r = |k: usize| if k == 0 { rvec } else { -rvec * weights[k - 1] };
-                for (k, &nd) in std::iter::once(&(s as u32)).chain(&masters[..nm as usize]).enumerate() {
+                for (k, &nd) in std::iter::once(&s).chain(&masters[..nm as usize]).enumerate() {
                     if self.block_nodes.binary_search(&nd).is_ok() {
                         let b = model.mass.block_of(nd as usize).expect("a block node");
                         let i0 = 3 * nd as usize;
@@ -944,38 +1200,23 @@ impl ContactSolver<'_> {
         self.step_clock += 1;
         self.local.clear();
         self.local_global.clear();
-        let ContactSolver { active, node, local, local_global, step_clock, mob_matrix, .. } = self;
-        for (k, a) in active.iter_mut().enumerate() {
-            // the pair's nodes among the local nodes, copied from the prediction when first met
-            for b in 0..5 {
-                let nd = a.nodes[b] as usize;
-                let ns = &mut node[nd];
-                if ns.listed != *step_clock {
-                    ns.listed = *step_clock;
-                    ns.local = local.len() as u32;
-                    // clock 0: the sweeps stamp every node when they start the work list
-                    local.push(LocalNode { x: disp(u_next, nd), moved_at: 0 });
-                    local_global.push(nd as u32);
-                }
-                a.local[b] = ns.local;
-            }
-            // the warm-start force acts on the prediction before the first sweep (through the
-            // pair's mobilities, as a sweep's update does)
-            if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
-                let [n, t1, t2] = a.frame;
-                let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-                a.move_nodes_into(local, &r, mob_matrix, k);
-            }
-        }
+        let ContactSolver { active, node, local, local_global, step_clock, mob_matrix, mortar, .. } = self;
+        list_pairs_into(active, node, local, local_global, *step_clock, mob_matrix, u_next);
+        list_pairs_into(&mut mortar.active, node, local, local_global, *step_clock, &mortar.mob_matrix, u_next);
         if self.gs_colored {
             self.order_by_color();
         } else {
             self.order.clear();
             self.order.extend(0..self.active.len() as u32);
         }
+        // mortar pairs: in the order of the search, after the node-to-segment pairs
+        self.mortar.order.clear();
+        self.mortar.order.extend(0..self.mortar.active.len() as u32);
         self.sweep_start.resize(self.local.len(), Vector3::zeros());
         self.evaluated_at.clear();
         self.evaluated_at.resize(self.active.len(), 0);
+        self.mortar.evaluated_at.clear();
+        self.mortar.evaluated_at.resize(self.mortar.active.len(), 0);
     }
 
     /// The Gauss–Seidel sweeps over the active pairs; returns the sweeps made and whether they
@@ -989,9 +1230,10 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_matrix, .. } = self;
+        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_matrix, mortar, .. } = self;
         let mut sweeps = 0;
-        let mut converged = active.is_empty();
+        let pairs = active.len() + mortar.active.len();
+        let mut converged = pairs == 0;
         for (x0, l) in sweep_start.iter_mut().zip(local.iter()) {
             *x0 = l.x;
         }
@@ -1003,23 +1245,27 @@ impl ContactSolver<'_> {
         // pairs on a line of intersection, where most pairs have converged long before the
         // last). The mode depends only on the iterates: deterministic.
         let mut listed = false;
-        let mut moving = active.len();
+        let mut moving = pairs;
         let mut residual = 0.0;
+        let m = mortar;
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
-            if !listed && 2 * moving < active.len() {
+            if !listed && 2 * moving < pairs {
                 listed = true;
                 clock += 1;
                 local.iter_mut().for_each(|l| l.moved_at = clock);
             }
             moving = if listed {
-                sweep_pass::<true>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
+                sweep_pass::<true, 5>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
+                    + sweep_pass::<true, MORTAR_NODES>(&mut m.active, &m.order, local, &mut m.evaluated_at, &mut clock, &laws, mark_tol2, &m.mob_matrix)
             } else {
-                sweep_pass::<false>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
+                sweep_pass::<false, 5>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
+                    + sweep_pass::<false, MORTAR_NODES>(&mut m.active, &m.order, local, &mut m.evaluated_at, &mut clock, &laws, mark_tol2, &m.mob_matrix)
             };
             let max_du = sweep_change_into(local, sweep_start).sqrt();
             residual = max_du;
-            converged = max_du <= *gs_tolerance || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
+            converged = max_du <= *gs_tolerance
+                || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e)) && !m.active.iter().zip(m.evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
         }
         // the corrected displacements back into the prediction
         for (l, &nd) in local.iter().zip(local_global.iter()) {
@@ -1046,34 +1292,70 @@ impl ContactSolver<'_> {
             }
         }
         for a in &self.active {
-            let i = a.pair as usize;
-            let [n, t1, t2] = a.frame;
-            let p = &mut history.joints[a.joint as usize].pairs[i];
-            p.hist = a.hist;
-            p.state = a.state;
-            p.gap = a.gap;
-            p.r_n = a.r_n;
-            p.r_t = [a.r_t.x, a.r_t.y];
-            // accumulated tangential relative displacement over the step, from the final
-            // positions (the sweeps' local copies) and the relative displacement at t[n]:
-            // Δd = Δu_s − Σ N_I Δu_I = rel_u − Σ coef_b x_b
-            let rel = a.relative_displacement(&self.local);
-            let mut rel_prev = Vector3::zeros();
-            for b in 0..5 {
-                rel_prev += disp(u_prev, a.nodes[b] as usize) * a.coef[b];
-            }
-            let dd = a.rel_u - rel;
-            p.d_t[0] += dd.dot(&t1);
-            p.d_t[1] += dd.dot(&t2);
-            p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
-            // work of the pair force over the step, on the central-difference increment
-            // ½ (x[n+1] − x[n−1]) of the slave relative to the master point
-            let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
-            let du = (rel_prev - rel) * 0.5;
-            work += rvec.dot(&du);
+            work += record_pair_into(a, history, &self.local, u_prev);
+        }
+        for a in &self.mortar.active {
+            work += record_pair_into(a, history, &self.local, u_prev);
         }
         work
     }
+}
+
+/// List the nodes of the active pairs among the local nodes (copied from the prediction
+/// `u_next` when first met in the step `step_clock`), and apply each pair's warm-start force.
+fn list_pairs_into<const N: usize>(active: &mut [Active<N>], node: &mut [NodeScratch], local: &mut Vec<LocalNode>, local_global: &mut Vec<u32>, step_clock: u32, mob_matrix: &[[Matrix3<f64>; N]], u_next: &[f64]) {
+    for (k, a) in active.iter_mut().enumerate() {
+        // the pair's nodes among the local nodes, copied from the prediction when first met
+        for b in 0..a.span() {
+            let nd = a.nodes[b] as usize;
+            let ns = &mut node[nd];
+            if ns.listed != step_clock {
+                ns.listed = step_clock;
+                ns.local = local.len() as u32;
+                // clock 0: the sweeps stamp every node when they start the work list
+                local.push(LocalNode { x: disp(u_next, nd), moved_at: 0 });
+                local_global.push(nd as u32);
+            }
+            a.local[b] = ns.local;
+        }
+        // the warm-start force acts on the prediction before the first sweep (through the
+        // pair's mobilities, as a sweep's update does)
+        if a.r_n != 0.0 || a.r_t != Vector2::zeros() {
+            let [n, t1, t2] = a.frame;
+            let r = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
+            a.move_nodes_into(local, &r, mob_matrix, k);
+        }
+    }
+}
+
+/// Write active pair `a`'s result into the history; returns the work of its force over the
+/// step [J].
+fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, local: &[LocalNode], u_prev: &[f64]) -> f64 {
+    let i = a.pair as usize;
+    let [n, t1, t2] = a.frame;
+    let p = &mut history.joints[a.joint as usize].pairs[i];
+    p.hist = a.hist;
+    p.state = a.state;
+    p.gap = a.gap;
+    p.r_n = a.r_n;
+    p.r_t = [a.r_t.x, a.r_t.y];
+    // accumulated tangential relative displacement over the step, from the final
+    // positions (the sweeps' local copies) and the relative displacement at t[n]:
+    // Δd = Δu_s − Σ N_I Δu_I = rel_u − Σ coef_b x_b
+    let rel = a.relative_displacement(local);
+    let mut rel_prev = Vector3::zeros();
+    for b in 0..a.span() {
+        rel_prev += disp(u_prev, a.nodes[b] as usize) * a.coef[b];
+    }
+    let dd = a.rel_u - rel;
+    p.d_t[0] += dd.dot(&t1);
+    p.d_t[1] += dd.dot(&t2);
+    p.slip += Vector2::new(dd.dot(&t1), dd.dot(&t2)).norm();
+    // work of the pair force over the step, on the central-difference increment
+    // ½ (x[n+1] − x[n−1]) of the slave relative to the master point
+    let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
+    let du = (rel_prev - rel) * 0.5;
+    rvec.dot(&du)
 }
 
 impl Constraint<ContactState> for ContactSolver<'_> {
@@ -1083,7 +1365,7 @@ impl Constraint<ContactState> for ContactSolver<'_> {
         let now_if = |on: bool| on.then(std::time::Instant::now);
         let timed = self.timings.is_some();
         let t_search = now_if(timed);
-        let penalty_work = self.search_into(model, history, dt2, u_prev, u, u_next);
+        let penalty_work = self.search_into(model, history, dt2, u_prev, u, u_next)?;
         let t_prepare = now_if(timed);
         self.prepare_sweeps_into(u_next);
         let t_sweeps = now_if(timed);

@@ -19,6 +19,10 @@ pub enum Method {
     Nts,
     /// Node-to-node: each slave node paired with its initial nearest master node O (N = [1]).
     Ntn,
+    /// Dual mortar (segment-to-segment): each slave node's pair has as master the combination
+    /// `Σ_k (M_jk / D_jj) x_k` of the master nodes its dual shape function overlaps
+    /// (`contact::mortar`; the force, the law and the Gauss–Seidel as NTS).
+    Mortar,
     /// Node-to-segment geometry with penalty springs instead of the dynamic contact force:
     /// normal `kn` and tangential `kt` stiffness per unit area [Pa/m].
     Penalty { kn: f64, kt: f64 },
@@ -67,6 +71,7 @@ impl ContactJoint {
         let method = match spec.method() {
             ContactMethod::Nts => Method::Nts,
             ContactMethod::Ntn => Method::Ntn,
+            ContactMethod::Mortar => Method::Mortar,
             ContactMethod::Penalty => {
                 let kn = spec.penalty_stiffness.ok_or_else(|| bad("method \"penalty\" needs `penalty_stiffness` [Pa/m]".into()))?;
                 if !(kn > 0.0 && kn.is_finite()) {

@@ -3,7 +3,9 @@
 //! Owns: the local search geometry ([`query`]: where the line from a slave node along its
 //! normal meets a master face, and whether it lands inside) and the per-pair contact law
 //! ([`law`]: the dynamic contact force of one pair in its local frame, Mohr-Coulomb with
-//! cohesion, tension and tied joints). Both are pure functions of their arguments: no mesh,
+//! cohesion, tension and tied joints), and the dual mortar geometry ([`mortar`]: dual shape
+//! functions, overlap clipping and quadrature, whose integrals make a mortar slave node's
+//! master weights). All are pure functions of their arguments: no mesh,
 //! no state, no allocation. Geometry is kept apart from mechanics: a query says *where*
 //! a slave node lands on the master surface; the law says *what force* the pair carries.
 //!
@@ -41,6 +43,7 @@
 pub mod force;
 pub mod joint;
 pub mod law;
+pub mod mortar;
 pub mod query;
 pub mod state;
 

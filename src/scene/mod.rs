@@ -648,7 +648,7 @@ pub struct JointSceneSpec {
     pub penalty_stiffness: Option<f64>,
 }
 
-/// A joint's contact method as written in a scene (`"nts"`, `"ntn"`, `"penalty"`), checked when
+/// A joint's contact method as written in a scene (`"nts"`, `"ntn"`, `"penalty"`, `"mortar"`), checked when
 /// the scene is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -659,6 +659,8 @@ pub enum ContactMethod {
     Ntn,
     /// Node-to-segment geometry with penalty springs (`penalty_stiffness`).
     Penalty,
+    /// Dual mortar, segment-to-segment (docs/contact.md, "Dual mortar").
+    Mortar,
 }
 
 impl ContactMethod {
@@ -668,6 +670,7 @@ impl ContactMethod {
             ContactMethod::Nts => "nts",
             ContactMethod::Ntn => "ntn",
             ContactMethod::Penalty => "penalty",
+            ContactMethod::Mortar => "mortar",
         }
     }
 }
@@ -679,7 +682,8 @@ impl std::str::FromStr for ContactMethod {
             "nts" => Ok(ContactMethod::Nts),
             "ntn" => Ok(ContactMethod::Ntn),
             "penalty" => Ok(ContactMethod::Penalty),
-            other => Err(format!("contact method \"{other}\" is not one of \"nts\", \"ntn\", \"penalty\"")),
+            "mortar" => Ok(ContactMethod::Mortar),
+            other => Err(format!("contact method \"{other}\" is not one of \"nts\", \"ntn\", \"penalty\", \"mortar\"")),
         }
     }
 }

@@ -84,6 +84,9 @@ pub enum Errors {
         force_min: f64,
         force_max: f64,
         duration: f64,
+        /// Work of the contact forces over the run over the bar's initial kinetic energy (> 0:
+        /// the contact created energy; exact closure does no work, 0 to round-off).
+        contact_work: f64,
     },
 }
 
@@ -273,5 +276,6 @@ fn run_impact(case: &Case, sim: &mut Simulation<'_>, force: f64, duration: f64) 
     if count == 0 || first.is_nan() {
         return Err(failed("impact: no contact force during the plateau (the bars never touched)".into()));
     }
-    Ok((Errors::Impact { force_mean: sum / count as f64 / force - 1.0, force_min: f_min / force - 1.0, force_max: f_max / force - 1.0, duration: (last - first + dt) / duration - 1.0 }, steps))
+    let contact_work = sim.state.energy.contact_work / e0;
+    Ok((Errors::Impact { force_mean: sum / count as f64 / force - 1.0, force_min: f_min / force - 1.0, force_max: f_max / force - 1.0, duration: (last - first + dt) / duration - 1.0, contact_work }, steps))
 }

@@ -16,6 +16,7 @@ mod dynamics;
 mod fuzz;
 mod joint_tests;
 mod mesh;
+mod mortar;
 mod motion;
 mod motion_scene;
 mod outputs;

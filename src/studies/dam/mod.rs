@@ -143,6 +143,8 @@ pub enum Method {
     Monolithic,
     #[serde(rename = "penalty")]
     Penalty,
+    #[serde(rename = "mortar")]
+    Mortar,
 }
 
 impl Method {
@@ -153,6 +155,7 @@ impl Method {
             Method::NtsLayer2 => "NTS-Layer2",
             Method::Monolithic => "monolithic",
             Method::Penalty => "penalty",
+            Method::Mortar => "mortar",
         }
     }
 }
@@ -280,6 +283,7 @@ impl DamKind {
                 (true, _, _) => Method::Monolithic,
                 (false, ContactMethod::Ntn, _) => Method::Ntn,
                 (false, ContactMethod::Penalty, _) => Method::Penalty,
+                (false, ContactMethod::Mortar, _) => Method::Mortar,
                 (false, ContactMethod::Nts, 2) => Method::NtsLayer2,
                 (false, ContactMethod::Nts, _) => Method::Nts,
             },
