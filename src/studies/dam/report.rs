@@ -44,14 +44,14 @@ pub struct Accuracy {
 fn mm(x: f64) -> String {
     fmt_sig(1e3 * x, 4)
 }
-fn mpa(x: f64) -> String {
+pub(super) fn mpa(x: f64) -> String {
     fmt_sig(1e-6 * x, 4)
 }
 /// A level as `1×`, `0.1×`, `2.5×` (3 decimals at most).
-fn lvl(x: f64) -> String {
+pub(super) fn lvl(x: f64) -> String {
     format!("{}×", lvl_num(x))
 }
-fn lvl_num(x: f64) -> f64 {
+pub(super) fn lvl_num(x: f64) -> f64 {
     (1e3 * x).round() / 1e3
 }
 /// " (stopped at t = … s)" for a run that stopped, else nothing: its maxima are up to there.
@@ -158,6 +158,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     largest_slip_section(&r, &mut doc);
     stress_section(&r, &mut doc);
     stress_against_seed_section(&r, &mut doc);
+    super::face_maps::face_maps_section(&r, &mut doc)?;
     histories_section(&r, &mut doc)?;
     let claims = claims(kind, &r.runs, &r.levels);
     claims_section(&claims, &mut doc);
@@ -292,7 +293,7 @@ fn per_joint_section(r: &DamReport, doc: &mut Doc, q: Quantity) -> Result<(), Er
     for &l in &r.levels {
         let mut c = Chart::new(
             format!("Largest joint {what} over the record, {}", lvl(l)),
-            "joint (1 = left bank)",
+            "joint number (1 = left bank) [-]",
             format!("largest {what} [mm]"),
         );
         for m in [Method::Nts, Method::Ntn, Method::NtsLayer2] {
@@ -735,7 +736,7 @@ fn speed_chart_section(r: &DamReport, acc: &[Accuracy], doc: &mut Doc) -> Result
     let mut c = Chart::new(
         format!("Speed against accuracy at {}", lvl(l)),
         "wall time [s]",
-        "error against the reference",
+        "relative error against the reference [-]",
     );
     c.x_axis = Axis::Log;
     c.y_axis = Axis::Log;
