@@ -497,6 +497,26 @@ impl Chart {
         Ok(())
     }
 
+    /// The legend right of the plot ([`Legend::Outside`]): per named series its swatch (line
+    /// and/or marker as drawn) and name, from the top of the plot down.
+    fn draw_outside_legend<DB: DrawingBackend>(&self, plan: &ChartPlan, root: &DrawingArea<DB, Shift>) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        let x0 = self.width as i32 - MARGIN as i32 - plan.outside_legend_px as i32 + LEGEND_OUTSIDE_GAP as i32;
+        let mut y = MARGIN as i32 + 50;
+        let font = (FAMILY, FONT_LEGEND).into_font().color(&BLACK);
+        for (i, s) in self.series.iter().enumerate().filter(|(_, s)| !s.name.is_empty()) {
+            let color = series_color(i);
+            if s.style.draws_line() {
+                root.draw(&PathElement::new(vec![(x0, y), (x0 + 24, y)], ShapeStyle { color: color.to_rgba(), filled: false, stroke_width: LINE_WIDTH }))?;
+            }
+            if s.style.draws_markers() {
+                root.draw(&(EmptyElement::at((x0 + 12, y)) + Polygon::new(series_marker(i).vertices(), color.filled())))?;
+            }
+            root.draw(&Text::new(s.name.clone(), (x0 + 32, y - 8), font.clone()))?;
+            y += 22;
+        }
+        Ok(())
+    }
+
     fn draw_error(&self, target: String, message: String) -> ReportError {
         ReportError::Draw { chart: self.title.clone(), target, message }
     }
@@ -589,8 +609,11 @@ impl Chart {
         }
 
         if let Some(corner) = plan.legend {
+            if corner == Legend::Outside {
+                // plotters clamps its legend to the plotting area: drawn here on the whole image
+                return self.draw_outside_legend(plan, root);
+            }
             let position = match corner {
-                Legend::Outside => SeriesLabelPosition::Coordinate(chart.plotting_area().dim_in_pixel().0 as i32 + LEGEND_OUTSIDE_GAP as i32, 0),
                 Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
                 Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
                 Legend::LowerRight => SeriesLabelPosition::LowerRight,
