@@ -36,6 +36,7 @@
 //! force ([`super::law::penalty_force`]: Mohr-Coulomb, cohesion, tension, tied), applied as an
 //! external force of step n (so it is explicit and lowers the stable step).
 
+use super::free_edge;
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force_with_inverse, penalty_force, JointLaw, PairHistory, PairState};
 pub use super::state::{ContactState, JointRecord, PairRecord, SearchEvents};
@@ -745,6 +746,12 @@ impl ContactSolver<'_> {
                         Some((f, p)) => masters_on_face(j, rec, i, f, &p),
                         None => {
                             lose_pair(rec, i);
+                            // beyond the master's free edge (expected) or lost inside it
+                            self.candidates_into(j, rec.pairs[i].center, 2);
+                            let near = free_edge::outline_faces(&j.tag.master, &self.cand, |g| pos(model, conf, g));
+                            if free_edge::lost_where(&near, &xs, &j.frames[i][0]) == free_edge::LostWhere::BeyondFreeEdge {
+                                rec.events.lost_beyond_edge += 1;
+                            }
                             continue;
                         }
                     },

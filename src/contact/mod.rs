@@ -36,11 +36,15 @@
 //! - **Pair compliance** `dt² w` with `w = 1/m_s + Σ N_I² / m_I` (1/kg): a force `R` on the pair
 //!   changes its relative displacement at the end of the step by `dt² w R`.
 //!
+//! A lost slave node (no master face found) is classified by [`free_edge`]: beyond the master's
+//! free edge (expected when a block slides out) or lost inside its outline.
+//!
 //! Invariants: a query returns exactly one face per slave node or `None`, the same whatever
 //! the order of the candidates; a law response closes the trial gap exactly in compression and
 //! never exceeds the Mohr-Coulomb limit in shear.
 
 pub mod force;
+pub mod free_edge;
 pub mod joint;
 pub mod law;
 pub mod mortar;

@@ -39,8 +39,13 @@ pub struct SearchEvents {
     pub fresh_searches: u64,
     /// Times the centre of a candidate set moved to follow its slave node (`widen` only).
     pub recentred: u64,
-    /// Node-steps with no master face found (force-free that step).
+    /// Node-steps with no master face found (force-free that step), all of them.
     pub lost: u64,
+    /// Of `lost`, those whose projection lay beyond the master surface's free edge
+    /// ([`super::free_edge`]): slid past the end of the surface, expected; the rest are lost
+    /// inside its outline.
+    #[serde(default)]
+    pub lost_beyond_edge: u64,
     /// Quad projections that did not converge (the face was skipped).
     pub projection_failures: u64,
     /// Node-steps kept in contact by the joint's `edge_tolerance`: the node was just outside the

@@ -11,7 +11,8 @@
 //!
 //! Written at the end of the run: `envelope.vtu` (the faces, cell fields `max_principal`,
 //! `min_principal` [Pa], `max_principal_t`, `min_principal_t` [s], `group` = index in `faces`)
-//! for ParaView, and `envelope.json`, read back by [`StressEnvelope::read`].
+//! for ParaView, and `envelope.json` (also each face's corners, for maps), read back by
+//! [`StressEnvelope::read`].
 
 use crate::error::{ModelError, OutputError};
 use crate::model::Model;
@@ -47,6 +48,11 @@ pub struct FaceEnvelope {
     pub max_tension: Extreme,
     /// The smallest σ3 over the group (the largest compression when < 0).
     pub max_compression: Extreme,
+    /// Per face: its corners in the reference configuration [m] (3 or 4, the face's node
+    /// order), for maps of the face (the dam report's face maps). Empty in files written before
+    /// it was added.
+    #[serde(default)]
+    pub corners: Vec<Vec<[f64; 3]>>,
 }
 
 /// What `envelope.json` holds.
@@ -75,6 +81,7 @@ impl StressEnvelope {
         for f in &env.faces {
             if f.max_principal.len() != f.elements.len()
                 || f.min_principal.len() != f.elements.len()
+                || (!f.corners.is_empty() && f.corners.len() != f.elements.len())
             {
                 return Err(OutputError::read(
                     &file,
@@ -242,6 +249,16 @@ impl EnvelopeWriter {
                     min_principal: fs.iter().map(|&(_, e)| self.min_s3[e].0).collect(),
                     max_tension: ten,
                     max_compression: com,
+                    corners: fs
+                        .iter()
+                        .map(|&(c, _)| {
+                            mesh.cells[c]
+                                .nodes()
+                                .iter()
+                                .map(|&i| mesh.nodes[i as usize])
+                                .collect()
+                        })
+                        .collect(),
                 }
             })
             .collect();

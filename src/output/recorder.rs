@@ -57,7 +57,8 @@ pub const MIN_HISTORY_ROWS: f64 = 1000.0;
 /// A joint whose lost node-steps (no master face: no contact force) exceed this fraction of its
 /// slave node-steps gets a warning: 1 %. A lost node is force-free, so a block whose contact is
 /// lost sinks into or falls through its base with the run still "passing" (`on_exit: "report"`
-/// let a block sink 3.7 m); 1 % is far above the few edge nodes of a sliding wedge that daylight
+/// let a block sink 3.7 m); counted over the nodes lost inside the master's outline (those beyond
+/// its free edge are a note, `contact::free_edge`); 1 % is far above the few edge nodes of a sliding wedge that daylight
 /// near the end of a run, and far below a face that lost its contact.
 pub const LOST_WARN_FRACTION: f64 = 0.01;
 
@@ -277,7 +278,7 @@ impl Recorder {
             joint_series: self.joints.as_ref().map(|j| j.pvd_paths()).unwrap_or_default(),
             joints: self.joints.as_ref().map(|j| j.peaks.clone()).unwrap_or_default(),
             out_dir: self.out_dir.clone(),
-            notes: sim.notes.clone(),
+            notes: sim.notes.iter().cloned().chain(self.lost_notes(sim)).collect(),
             timings,
             wall_time,
             provenance: Some(crate::output::summary::Provenance::of_this_process()),
@@ -313,12 +314,14 @@ impl Recorder {
         let mut gs: Vec<(u64, f64, f64, Vec<String>)> = Vec::new();
         for (pk, j) in jw.peaks.iter().zip(&sim.problem.joints) {
             let node_steps = pk.slave_nodes.max(1) as f64 * steps;
-            let lost = pk.events.lost as f64 / node_steps;
+            // lost inside the master's outline (not beyond its free edge: `lost_notes`)
+            let inside = pk.events.lost.saturating_sub(pk.events.lost_beyond_edge);
+            let lost = inside as f64 / node_steps;
             if lost > LOST_WARN_FRACTION {
                 let hint = if matches!(j.on_exit, crate::contact::joint::OnExit::Widen) { "" } else { " (on_exit \"report\": the candidate set never follows the node; use \"widen\")" };
                 w.push(format!(
-                    "joint {}: {} node-steps lost ({:.1} % of its slave node-steps, above {:.0} %): lost nodes carry no contact force, so a block can sink into or fall through its base; the largest lost travel was {:.3e} m{hint}",
-                    pk.name, pk.events.lost, 100.0 * lost, 100.0 * LOST_WARN_FRACTION, pk.max_lost_travel
+                    "joint {}: {} node-steps lost inside the master surface's outline ({:.1} % of its slave node-steps, above {:.0} %): lost nodes carry no contact force, so a block can sink into or fall through its base; the largest lost travel was {:.3e} m{hint}",
+                    pk.name, inside, 100.0 * lost, 100.0 * LOST_WARN_FRACTION, pk.max_lost_travel
                 ));
             }
             if pk.unconverged_steps > 0 && pk.gs_tolerance > 0.0 && pk.max_gs_residual > GS_WARN_FACTOR * pk.gs_tolerance {
@@ -345,6 +348,27 @@ impl Recorder {
             ));
         }
         w
+    }
+
+    /// Notes of the slave nodes that slid beyond their master's free edge (the projection outside
+    /// the master surface's outer boundary, `contact::free_edge`): no contact there, as expected
+    /// when a block slides out past the end of what it rests on; one note per joint with any.
+    fn lost_notes(&self, sim: &Simulation<'_>) -> Vec<String> {
+        let Some(jw) = self.joints.as_ref() else { return Vec::new() };
+        let steps = self.stop.unwrap_or(sim.n_steps()).max(1) as f64;
+        jw.peaks
+            .iter()
+            .filter(|pk| pk.events.lost_beyond_edge > 0)
+            .map(|pk| {
+                let b = pk.events.lost_beyond_edge;
+                format!(
+                    "joint {}: {b} node-steps ({:.1} % of its slave node-steps) beyond the master's free edge: the slave nodes slid past the end of the master surface (their projection lies outside its outer boundary), so they touch nothing there; expected where a block slides out; {} node-steps lost inside its outline",
+                    pk.name,
+                    100.0 * b as f64 / (pk.slave_nodes.max(1) as f64 * steps),
+                    pk.events.lost - b
+                )
+            })
+            .collect()
     }
 
     /// Whether output index `m` gets a history row (`last`: the run's last index).

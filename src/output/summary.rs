@@ -194,8 +194,8 @@ impl RunSummary {
             if e.widened_layer2 + e.fresh_searches + e.lost + e.projection_failures + e.recentred + e.perimeter_kept > 0 {
                 let _ = writeln!(
                     s,
-                    "                 search: {} re-centrings, {} kept at the perimeter, {} Layer2 widenings, {} fresh searches, {} node-steps lost, {} projection failures",
-                    e.recentred, e.perimeter_kept, e.widened_layer2, e.fresh_searches, e.lost, e.projection_failures
+                    "                 search: {} re-centrings, {} kept at the perimeter, {} Layer2 widenings, {} fresh searches, {} node-steps lost ({} beyond the master's free edge), {} projection failures",
+                    e.recentred, e.perimeter_kept, e.widened_layer2, e.fresh_searches, e.lost, e.lost_beyond_edge, e.projection_failures
                 );
             }
         }

@@ -9,13 +9,15 @@ use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 
 use plotters::coord::Shift;
-use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
+use plotters::coord::combinators::LogCoord;
+use plotters::coord::ranged1d::{AsRangedCoord, DefaultFormatting, KeyPointHint, Ranged, ValueFormatter};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::file::{write_atomic, write_via_temp};
 use super::font::{FAMILY, ensure_registered};
 pub use super::scale::Axis;
-use super::scale::{Window, auto_range, fmt_tick, from_axis, to_axis};
+use super::scale::{Along, Ticks, Window, auto_range, fmt_tick, from_axis, ticks, to_axis};
 use crate::error::ReportError;
 
 /// Default image width, px: with [`DEFAULT_HEIGHT`], 3:2, a 6 × 4 in figure at 150 dpi,
@@ -51,15 +53,14 @@ const FONT_TITLE: u32 = 24;
 const FONT_AXIS_LABEL: u32 = 18;
 const FONT_TICKS: u32 = 15;
 const FONT_LEGEND: u32 = 15;
-const FONT_POINT_LABEL: u32 = 14;
+const FONT_POINT_LABEL: u32 = 15;
 /// Outer margin, x tick/label band, y tick/label band, px. The y band holds tick labels
 /// like "-1.2345e-5" beside a rotated axis label.
 const MARGIN: u32 = 20;
 const X_LABEL_AREA: u32 = 55;
 const Y_LABEL_AREA: u32 = 90;
-/// Light grid lines between labelled ticks: 4 marks fifths, enough to read values off the
-/// chart without the grid competing with the data (plotters' default of 10 does).
-const LIGHT_LINES: usize = 4;
+/// Gap between the plot's right edge and a legend drawn outside it ([`Legend::Outside`]), px.
+const LEGEND_OUTSIDE_GAP: u32 = 10;
 /// Offset of a point label from its marker, px, right and up, clear of the marker.
 const POINT_LABEL_OFFSET: (i32, i32) = (8, -18);
 
@@ -203,6 +204,9 @@ pub enum Legend {
     UpperRight,
     LowerLeft,
     LowerRight,
+    /// Right of the plot, outside it (the plot narrows to make room): what `Auto` chooses when
+    /// every inner corner would cover drawn data.
+    Outside,
     /// No legend.
     Hidden,
 }
@@ -242,6 +246,11 @@ pub struct ChartPlan {
     pub y_range: (f64, f64),
     /// The legend corner, `None` if no legend is drawn.
     pub legend: Option<Legend>,
+    /// Extra right margin for a legend outside the plot, px (0 otherwise).
+    pub outside_legend_px: u32,
+    /// The axes' ticks ([`crate::report::scale::ticks`]), for the plot narrowed by the legend.
+    pub x_ticks: Ticks,
+    pub y_ticks: Ticks,
     window: Window,
 }
 
@@ -307,8 +316,15 @@ impl Chart {
             (to_axis(self.x_axis, x_range.0), to_axis(self.x_axis, x_range.1)),
             (to_axis(self.y_axis, y_range.0), to_axis(self.y_axis, y_range.1)),
         );
-        let mut plan = ChartPlan { x_range, y_range, legend: None, window };
+        let mut plan = ChartPlan { x_range, y_range, legend: None, outside_legend_px: 0, x_ticks: Ticks::default(), y_ticks: Ticks::default(), window };
         plan.legend = self.legend_corner(&plan);
+        if plan.legend == Some(Legend::Outside) {
+            plan.outside_legend_px = self.legend_box_px().0.ceil() as u32 + LEGEND_OUTSIDE_GAP;
+        }
+        let (pw, ph) = self.plot_pixels();
+        let pw = (pw - plan.outside_legend_px as f64).max(1.0);
+        plan.x_ticks = ticks(self.x_axis, x_range, pw, FONT_TICKS as f64, Along::Horizontal);
+        plan.y_ticks = ticks(self.y_axis, y_range, ph, FONT_TICKS as f64, Along::Vertical);
         Ok(plan)
     }
 
@@ -381,12 +397,9 @@ impl Chart {
         if self.legend != Legend::Auto {
             return Some(self.legend);
         }
-        // Legend box estimate: swatch and padding 45 px + 0.6 em per char wide, 22 px per entry
-        // high, plus plotters' 5 px legend margin; all as fractions of the plot.
         let (pw, ph) = self.plot_pixels();
-        let chars = named.iter().map(|s| s.name.chars().count()).max().unwrap_or(0) as f64;
-        let bw = ((45.0 + 0.6 * FONT_LEGEND as f64 * chars + 10.0) / pw).min(1.0);
-        let bh = ((22.0 * named.len() as f64 + 20.0) / ph).min(1.0);
+        let (bw, bh) = self.legend_box_px();
+        let (bw, bh) = ((bw / pw).min(1.0), (bh / ph).min(1.0));
         let samples = self.drawn_samples(plan);
         let corners = [
             (Legend::UpperRight, (1.0 - bw, 1.0), (1.0 - bh, 1.0)),
@@ -395,8 +408,17 @@ impl Chart {
             (Legend::LowerLeft, (0.0, bw), (0.0, bh)),
         ];
         let count = |x: (f64, f64), y: (f64, f64)| samples.iter().filter(|p| p.0 >= x.0 && p.0 <= x.1 && p.1 >= y.0 && p.1 <= y.1).count();
-        // min_by_key keeps the first of equal counts: the tie order above.
-        corners.iter().min_by_key(|(_, x, y)| count(*x, *y)).map(|c| c.0)
+        // min_by_key keeps the first of equal counts: the tie order above; outside the plot
+        // when every corner covers data
+        corners.iter().map(|(c, x, y)| (*c, count(*x, *y))).min_by_key(|c| c.1).map(|(c, n)| if n == 0 { c } else { Legend::Outside })
+    }
+
+    /// Estimated legend box (width, height), px: swatch and padding 45 px + 0.6 em per char
+    /// wide, 22 px per entry high, plus plotters' 5 px legend margin.
+    fn legend_box_px(&self) -> (f64, f64) {
+        let named: Vec<&Series> = self.series.iter().filter(|s| !s.name.is_empty()).collect();
+        let chars = named.iter().map(|s| s.name.chars().count()).max().unwrap_or(0) as f64;
+        (45.0 + 0.6 * FONT_LEGEND as f64 * chars + 10.0, 22.0 * named.len() as f64 + 20.0)
     }
 
     /// Pieces of the series' line inside the window, in axis space.
@@ -475,6 +497,26 @@ impl Chart {
         Ok(())
     }
 
+    /// The legend right of the plot ([`Legend::Outside`]): per named series its swatch (line
+    /// and/or marker as drawn) and name, from the top of the plot down.
+    fn draw_outside_legend<DB: DrawingBackend>(&self, plan: &ChartPlan, root: &DrawingArea<DB, Shift>) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+        let x0 = self.width as i32 - MARGIN as i32 - plan.outside_legend_px as i32 + LEGEND_OUTSIDE_GAP as i32;
+        let mut y = MARGIN as i32 + 50;
+        let font = (FAMILY, FONT_LEGEND).into_font().color(&BLACK);
+        for (i, s) in self.series.iter().enumerate().filter(|(_, s)| !s.name.is_empty()) {
+            let color = series_color(i);
+            if s.style.draws_line() {
+                root.draw(&PathElement::new(vec![(x0, y), (x0 + 24, y)], ShapeStyle { color: color.to_rgba(), filled: false, stroke_width: LINE_WIDTH }))?;
+            }
+            if s.style.draws_markers() {
+                root.draw(&(EmptyElement::at((x0 + 12, y)) + Polygon::new(series_marker(i).vertices(), color.filled())))?;
+            }
+            root.draw(&Text::new(s.name.clone(), (x0 + 32, y - 8), font.clone()))?;
+            y += 22;
+        }
+        Ok(())
+    }
+
     fn draw_error(&self, target: String, message: String) -> ReportError {
         ReportError::Draw { chart: self.title.clone(), target, message }
     }
@@ -482,11 +524,14 @@ impl Chart {
     fn draw<DB: DrawingBackend>(&self, plan: &ChartPlan, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let (x, y) = (plan.x_range.0..plan.x_range.1, plan.y_range.0..plan.y_range.1);
+        let (tx, ty) = (plan.x_ticks.clone(), plan.y_ticks.clone());
+        let lin = |r: std::ops::Range<f64>, t: Ticks| Ticked { inner: RangedCoordf64::from(r), ticks: t };
+        let log = |r: std::ops::Range<f64>, t: Ticks| Ticked { inner: LogCoord::<f64>::from(r.log_scale()), ticks: t };
         match (self.x_axis, self.y_axis) {
-            (Axis::Linear, Axis::Linear) => self.draw_on(plan, root, x, y),
-            (Axis::Log, Axis::Linear) => self.draw_on(plan, root, x.log_scale(), y),
-            (Axis::Linear, Axis::Log) => self.draw_on(plan, root, x, y.log_scale()),
-            (Axis::Log, Axis::Log) => self.draw_on(plan, root, x.log_scale(), y.log_scale()),
+            (Axis::Linear, Axis::Linear) => self.draw_on(plan, root, lin(x, tx), lin(y, ty)),
+            (Axis::Log, Axis::Linear) => self.draw_on(plan, root, log(x, tx), lin(y, ty)),
+            (Axis::Linear, Axis::Log) => self.draw_on(plan, root, lin(x, tx), log(y, ty)),
+            (Axis::Log, Axis::Log) => self.draw_on(plan, root, log(x, tx), log(y, ty)),
         }
         .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())
@@ -503,6 +548,7 @@ impl Chart {
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, (FAMILY, FONT_TITLE))
             .margin(MARGIN)
+            .margin_right(MARGIN + plan.outside_legend_px)
             .x_label_area_size(X_LABEL_AREA)
             .y_label_area_size(Y_LABEL_AREA)
             .build_cartesian_2d(x, y)?;
@@ -518,7 +564,6 @@ impl Chart {
             .axis_desc_style((FAMILY, FONT_AXIS_LABEL))
             .x_label_formatter(&x_tick)
             .y_label_formatter(&y_tick)
-            .max_light_lines(LIGHT_LINES)
             .draw()?;
 
         for (i, s) in self.series.iter().enumerate() {
@@ -564,6 +609,10 @@ impl Chart {
         }
 
         if let Some(corner) = plan.legend {
+            if corner == Legend::Outside {
+                // plotters clamps its legend to the plotting area: drawn here on the whole image
+                return self.draw_outside_legend(plan, root);
+            }
             let position = match corner {
                 Legend::UpperLeft => SeriesLabelPosition::UpperLeft,
                 Legend::LowerLeft => SeriesLabelPosition::LowerLeft,
@@ -579,6 +628,34 @@ impl Chart {
                 .draw()?;
         }
         Ok(())
+    }
+}
+
+/// A plotters coordinate with our ticks ([`ChartPlan::x_ticks`]) instead of its own key points,
+/// so log axes get 1-2-5 or decade labels and no axis gets overlapping labels.
+pub(crate) struct Ticked<R> {
+    pub(crate) inner: R,
+    pub(crate) ticks: Ticks,
+}
+
+impl<R: Ranged<ValueType = f64>> Ranged for Ticked<R> {
+    type ValueType = f64;
+    type FormatOption = DefaultFormatting;
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() { self.ticks.light.clone() } else { self.ticks.labelled.clone() }
+    }
+
+    fn axis_pixel_range(&self, limit: (i32, i32)) -> std::ops::Range<i32> {
+        self.inner.axis_pixel_range(limit)
     }
 }
 

@@ -1,8 +1,8 @@
 //! Report: charts (PNG + SVG) and Markdown tables for study reports.
 //!
 //! Owns only presentation. Inputs: numbers the caller already has (series of `(x, y)`
-//! points with names, table cells as strings); it knows nothing of scenes, models or
-//! studies. Outputs: `<stem>.png` and `<stem>.svg` per [`Chart`], Markdown text or files
+//! points with names, polygons with values for maps, table cells as strings); it knows nothing of scenes, models or
+//! studies. Outputs: `<stem>.png` and `<stem>.svg` per [`Chart`] and [`Map`], Markdown text or files
 //! per [`Table`].
 //!
 //! Invariants:
@@ -19,6 +19,7 @@
 pub mod chart;
 pub mod file;
 pub mod font;
+pub mod map;
 pub mod pareto;
 pub mod scale;
 pub mod table;
@@ -28,5 +29,6 @@ pub use chart::{
     Axis, Chart, ChartFiles, ChartPlan, Legend, Marker, Series, SeriesStyle, DEFAULT_HEIGHT, DEFAULT_WIDTH, MARKERS, MIN_SIZE,
     PALETTE, series_color, series_marker,
 };
+pub use map::{Map, MapPanel};
 pub use pareto::pareto_front;
 pub use table::{Align, Table, fmt_percent, fmt_sig};

@@ -177,6 +177,123 @@ pub fn fmt_tick(v: f64, zero_below: f64) -> String {
     }
 }
 
+/// Advance width of a tick-label character, em, for spacing labels: DejaVu Sans's digits are
+/// 1303 of 2048 units wide (0.636 em), its widest tick character ('.' and '-' are narrower).
+pub const TICK_CHAR_EM: f64 = 0.64;
+
+/// Smallest free space between neighbouring tick labels, px: half an em of the 15 px tick
+/// font, so two labels never read as one number ("700800901000").
+pub const TICK_GAP_PX: f64 = 8.0;
+
+/// Fewest pixels per labelled tick on a linear axis: at most one label per 50 px keeps a
+/// 600 px axis to about a dozen labels even when short labels would fit more.
+pub const TICK_MIN_SPACING_PX: f64 = 50.0;
+
+/// Along which image direction an axis runs: a horizontal axis's labels take their width
+/// along it, a vertical axis's labels their height.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Along {
+    Horizontal,
+    Vertical,
+}
+
+/// The ticks of one axis (values, ascending): `labelled` carry a label and a grid line,
+/// `light` only a light grid line.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Ticks {
+    pub labelled: Vec<f64>,
+    pub light: Vec<f64>,
+}
+
+/// Ticks for the range `(lo, hi)` (values) drawn over `pixels` px with labels of `font_px`.
+///
+/// The densest set among round candidates whose labels do not overlap (with [`TICK_GAP_PX`]
+/// between them, widths estimated at [`TICK_CHAR_EM`] per character of [`fmt_tick`]'s text):
+///
+/// - linear: multiples of 1, 2 or 5 × 10^k, at most one per [`TICK_MIN_SPACING_PX`];
+/// - log: 1, 2 and 5 × each decade, then every decade, then every 2nd, 5th, 10th … decade;
+///   when none of these puts two labels on the axis (a range within a factor of about 2, such
+///   as 700–1000), the linear candidates, placed on the log axis.
+///
+/// At least two labels whenever any candidate gives two; light ticks subdivide the labelled
+/// ones (fifths of a linear step; the other integer multiples within a decade on a log axis).
+pub fn ticks(axis: Axis, range: (f64, f64), pixels: f64, font_px: f64, along: Along) -> Ticks {
+    let (ua, ub) = (to_axis(axis, range.0), to_axis(axis, range.1));
+    let zero_below = if axis == Axis::Linear { 1e-9 * (range.1 - range.0) } else { 0.0 };
+    let px = |v: f64| (to_axis(axis, v) - ua) / (ub - ua) * pixels;
+    let extent = |v: f64| match along {
+        Along::Horizontal => TICK_CHAR_EM * font_px * fmt_tick(v, zero_below).chars().count() as f64,
+        Along::Vertical => font_px,
+    };
+    let fits = |t: &[f64]| {
+        t.windows(2).all(|w| px(w[1]) - px(w[0]) >= 0.5 * (extent(w[0]) + extent(w[1])) + TICK_GAP_PX)
+    };
+    let mut candidates: Vec<(Vec<f64>, Vec<f64>)> = Vec::new();
+    if axis == Axis::Log {
+        candidates.extend(log_candidates(range));
+    }
+    // linear steps, from about one per TICK_MIN_SPACING_PX up to the whole span
+    let span = range.1 - range.0;
+    let most = (pixels / TICK_MIN_SPACING_PX).max(1.0);
+    let mut k = (span / most).log10().floor() as i32;
+    'steps: loop {
+        for m in [1.0, 2.0, 5.0] {
+            let step = m * 10f64.powi(k);
+            if step < span / most {
+                continue;
+            }
+            let labelled = multiples(step, range);
+            let light = multiples(step / 5.0, range).into_iter().filter(|v| !labelled.iter().any(|l| close(*l, *v, step))).collect();
+            let done = labelled.len() < 2;
+            candidates.push((labelled, light));
+            if done {
+                break 'steps;
+            }
+        }
+        k += 1;
+    }
+    let pick = candidates.iter().find(|(l, _)| l.len() >= 2 && fits(l)).or_else(|| candidates.iter().find(|(l, _)| !l.is_empty() && fits(l)));
+    match pick {
+        Some((labelled, light)) => Ticks { labelled: labelled.clone(), light: light.clone() },
+        // nothing round fits (a range narrower than its labels): the middle alone
+        None => Ticks { labelled: vec![from_axis(axis, 0.5 * (ua + ub))], light: Vec::new() },
+    }
+}
+
+/// Whether `a` and `b` are the same tick, to round-off of a step `step`.
+fn close(a: f64, b: f64, step: f64) -> bool {
+    (a - b).abs() <= 1e-9 * step.abs()
+}
+
+/// The multiples of `step` in `range` (inclusive, to round-off), each computed as `i × step`.
+fn multiples(step: f64, range: (f64, f64)) -> Vec<f64> {
+    let (i0, i1) = ((range.0 / step - 1e-9).ceil(), (range.1 / step + 1e-9).floor());
+    if !(i0.is_finite() && i1.is_finite()) || i1 - i0 > 10_000.0 {
+        return Vec::new();
+    }
+    (i0 as i64..=i1 as i64).map(|i| i as f64 * step).collect()
+}
+
+/// Log-axis candidates, densest first: 1-2-5 in each decade, then every 1st, 2nd, 5th, 10th …
+/// decade; each with its light ticks.
+fn log_candidates(range: (f64, f64)) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let inside = |v: f64| v >= range.0 * (1.0 - 1e-9) && v <= range.1 * (1.0 + 1e-9);
+    let (d0, d1) = (range.0.log10().floor() as i32, range.1.log10().ceil() as i32);
+    let per_decade = |ms: &[f64], every: i32| -> Vec<f64> {
+        (d0..=d1).filter(|d| d.rem_euclid(every) == 0).flat_map(|d| ms.iter().map(move |m| m * 10f64.powi(d))).filter(|&v| inside(v)).collect()
+    };
+    let mut out = vec![(per_decade(&[1.0, 2.0, 5.0], 1), per_decade(&[3.0, 4.0, 6.0, 7.0, 8.0, 9.0], 1))];
+    out.push((per_decade(&[1.0], 1), per_decade(&[2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0], 1)));
+    let mut every = 2;
+    while every <= (d1 - d0).max(1) {
+        let labelled = per_decade(&[1.0], every);
+        let light = per_decade(&[1.0], 1).into_iter().filter(|v| !labelled.contains(v)).collect();
+        out.push((labelled, light));
+        every = if every.to_string().starts_with('2') { every / 2 * 5 } else { every * 2 };
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -242,5 +359,34 @@ mod tests {
         // Round-off at zero on a linear axis of span 2.
         assert_eq!(fmt_tick(-2.220446049250313e-16, 2e-9), "0");
         assert_eq!(fmt_tick(1e-7, 0.0), "1e-7");
+    }
+
+    #[test]
+    fn log_ticks_label_a_narrow_range_without_overlap() {
+        // the speed-against-accuracy chart of issue 32: wall times 700–1000 s read
+        // "700800901000" with plotters' own log ticks
+        let t = ticks(Axis::Log, (690.0, 1010.0), 770.0, 15.0, Along::Horizontal);
+        assert_eq!(t.labelled, vec![700.0, 750.0, 800.0, 850.0, 900.0, 950.0, 1000.0]);
+        // two decades: 1-2-5 (y axis, 15 px labels, 460 px)
+        let t = ticks(Axis::Log, (0.008, 0.6), 460.0, 15.0, Along::Vertical);
+        assert_eq!(t.labelled, vec![0.01, 0.02, 0.05, 0.1, 0.2, 0.5]);
+        assert!(t.light.contains(&0.03) && !t.light.contains(&0.02), "{t:?}");
+        // twelve decades on 400 px: every 2nd decade (decades would be 33 px apart, labels 5 chars)
+        let t = ticks(Axis::Log, (1e-9, 1e3), 400.0, 15.0, Along::Horizontal);
+        assert!(t.labelled.len() >= 3 && t.labelled.iter().all(|v| (v.log10().round() as i32) % 2 == 0), "{t:?}");
+    }
+
+    #[test]
+    fn linear_ticks_are_round_and_apart() {
+        let t = ticks(Axis::Linear, (-0.5, 10.5), 770.0, 15.0, Along::Horizontal);
+        assert_eq!(t.labelled, (0..=10).map(f64::from).collect::<Vec<_>>());
+        assert!(t.light.contains(&0.4) && !t.light.contains(&2.0));
+        // long labels (six digits) on a short axis: a coarser step
+        let t = ticks(Axis::Linear, (100000.0, 100100.0), 200.0, 15.0, Along::Horizontal);
+        assert!(t.labelled.len() >= 2, "{t:?}");
+        for w in t.labelled.windows(2) {
+            let gap = (w[1] - w[0]) / 100.0 * 200.0;
+            assert!(gap >= TICK_CHAR_EM * 15.0 * 6.0 + TICK_GAP_PX, "{t:?}");
+        }
     }
 }

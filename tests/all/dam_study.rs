@@ -262,4 +262,10 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
         "{:?}",
         r.charts
     );
+    // every chart reads at a glance (issue 32): two or more tick labels per axis, none
+    // overlapping, a unit on each axis, no text below 12 px
+    for c in &r.charts {
+        let svg = std::fs::read_to_string(c.with_extension("svg")).unwrap();
+        crate::report::assert_readable_svg(&svg, &c.display().to_string());
+    }
 }

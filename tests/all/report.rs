@@ -157,3 +157,123 @@ fn same_chart_gives_identical_files() {
     assert_eq!(std::fs::read(&a.png).unwrap(), std::fs::read(&b.png).unwrap());
     assert_eq!(std::fs::read(&a.svg).unwrap(), std::fs::read(&b.svg).unwrap());
 }
+
+/// A text element of an SVG written by plotters: position, font size [px], anchor, rotated, text.
+#[derive(Debug, Clone)]
+pub struct SvgText {
+    pub x: f64,
+    pub y: f64,
+    pub size: f64,
+    pub anchor: String,
+    pub rotated: bool,
+    pub text: String,
+}
+
+/// The `<text>` elements of an SVG (plotters writes one per label, its content on its own line).
+pub fn svg_texts(svg: &str) -> Vec<SvgText> {
+    let attr = |head: &str, name: &str| -> Option<String> {
+        let k = head.find(&format!(" {name}=\""))? + name.len() + 3;
+        Some(head[k..].split('"').next()?.to_string())
+    };
+    svg.split("<text ")
+        .skip(1)
+        .filter_map(|t| {
+            let (head, rest) = t.split_once('>')?;
+            let head = &format!(" {head}");
+            let text = rest.split("</text>").next()?.trim().to_string();
+            Some(SvgText {
+                x: attr(head, "x")?.parse().ok()?,
+                y: attr(head, "y")?.parse().ok()?,
+                size: attr(head, "font-size")?.parse().ok()?,
+                anchor: attr(head, "text-anchor").unwrap_or_default(),
+                rotated: head.contains("transform="),
+                text,
+            })
+        })
+        .collect()
+}
+
+/// Boxes (x0, y0, x1, y1) [px] of the tick labels of a chart SVG: unrotated numbers, x-axis
+/// labels centred under their tick (anchor middle, hanging below y), y-axis labels ending left of
+/// theirs (anchor end, centred on y). Width: 0.636 em per character (DejaVu Sans's digit advance,
+/// 1303 of 2048 units, its widest tick character), height 1 em.
+pub fn tick_label_boxes(svg: &str) -> (Vec<[f64; 4]>, Vec<[f64; 4]>) {
+    let (mut xs, mut ys) = (Vec::new(), Vec::new());
+    for t in svg_texts(svg).into_iter().filter(|t| !t.rotated && t.text.parse::<f64>().is_ok()) {
+        let w = 0.636 * t.size * t.text.chars().count() as f64;
+        match t.anchor.as_str() {
+            "middle" => xs.push([t.x - 0.5 * w, t.y, t.x + 0.5 * w, t.y + t.size]),
+            "end" => ys.push([t.x - w, t.y - 0.5 * t.size, t.x, t.y + 0.5 * t.size]),
+            _ => {}
+        }
+    }
+    (xs, ys)
+}
+
+/// The first pair of overlapping boxes, if any.
+pub fn overlapping(boxes: &[[f64; 4]]) -> Option<([f64; 4], [f64; 4])> {
+    for (i, a) in boxes.iter().enumerate() {
+        for b in &boxes[i + 1..] {
+            if a[0] < b[2] && b[0] < a[2] && a[1] < b[3] && b[1] < a[3] {
+                return Some((*a, *b));
+            }
+        }
+    }
+    None
+}
+
+/// Asserts a chart SVG's tick labels: at least two on each axis, none overlapping, and the
+/// axis descriptions (rotated y, and the x one under the plot) carrying a unit in brackets.
+pub fn assert_readable_svg(svg: &str, what: &str) {
+    let (xs, ys) = tick_label_boxes(svg);
+    assert!(xs.len() >= 2 && ys.len() >= 2, "{what}: {} x and {} y tick labels", xs.len(), ys.len());
+    for b in [&xs, &ys] {
+        assert!(overlapping(b).is_none(), "{what}: tick labels overlap: {:?}", overlapping(b));
+    }
+    let texts = svg_texts(svg);
+    let y_desc: Vec<&SvgText> = texts.iter().filter(|t| t.rotated).collect();
+    assert!(!y_desc.is_empty() && y_desc.iter().all(|t| t.text.contains('[')), "{what}: y axis description without a unit: {y_desc:?}");
+    // the x description: the lowest text (largest y) that is not a number
+    let x_desc = texts.iter().filter(|t| !t.rotated && t.text.parse::<f64>().is_err()).max_by(|a, b| a.y.total_cmp(&b.y));
+    assert!(x_desc.is_some_and(|t| t.text.contains('[')), "{what}: x axis description without a unit: {x_desc:?}");
+    assert!(texts.iter().all(|t| t.size >= 12.0), "{what}: text below 12 px: {:?}", texts.iter().find(|t| t.size < 12.0));
+}
+
+#[test]
+fn log_axes_of_a_narrow_speed_accuracy_chart_have_labelled_ticks_that_do_not_overlap() {
+    // issue 32: the dam report's speed-against-accuracy chart, wall times 700–1000 s and errors
+    // 1–40 %, read "700800901000" on x and had one label on y
+    let runs = [(1000.0, 0.01), (905.0, 0.03), (810.0, 0.12), (700.0, 0.4)];
+    let mut c = Chart::new("Speed against accuracy at 3×", "wall time [s]", "relative error against the reference [-]");
+    c.x_axis = Axis::Log;
+    c.y_axis = Axis::Log;
+    for (i, &p) in runs.iter().enumerate() {
+        c.series.push(Series::markers(format!("run {i}"), [p]));
+    }
+    c.series.push(Series::line("Pareto front", runs));
+    let mut svg = String::new();
+    c.render_svg_into(&mut svg).unwrap();
+    assert_readable_svg(&svg, "speed_accuracy");
+    let (xs, ys) = tick_label_boxes(&svg);
+    assert!(xs.len() >= 3 && ys.len() >= 3, "{xs:?} {ys:?}");
+    let labels: Vec<String> = svg_texts(&svg).into_iter().map(|t| t.text).collect();
+    for v in ["700", "800", "900", "1000", "0.01", "0.1"] {
+        assert!(labels.iter().any(|l| l == v), "no tick label {v}: {labels:?}");
+    }
+}
+
+#[test]
+fn a_legend_that_would_cover_data_in_every_corner_goes_outside_the_plot() {
+    // data in all four corners and the middle: no inner corner is free
+    let pts: Vec<(f64, f64)> = (0..=20).flat_map(|i| (0..=20).map(move |j| (i as f64, j as f64))).collect();
+    let c = Chart { series: vec![Series::markers("grid", pts), Series::line("diagonal", [(0.0, 0.0), (20.0, 20.0)])], ..Chart::new("Full", "x [m]", "y [m]") };
+    let plan = c.check().unwrap();
+    assert_eq!(plan.legend, Some(jointquake::report::Legend::Outside));
+    assert!(plan.outside_legend_px > 50);
+    let mut svg = String::new();
+    c.render_svg_into(&mut svg).unwrap();
+    // the legend's entries are right of every data marker's x
+    let texts = svg_texts(&svg);
+    let legend_x = texts.iter().find(|t| t.text == "grid").unwrap().x;
+    assert!(legend_x > 900.0 - 20.0 - plan.outside_legend_px as f64, "legend at x = {legend_x}");
+}

@@ -1,8 +1,14 @@
 //! The dam study's report: tables and charts from the runs read by [`super::DamKind::run`].
 //! Every number in a table comes from a run or from the study file's `seed` (the paper's
 //! values, quoted as such); a run without results is left out and named.
+//!
+//! [`report`] is a list of section calls: a section is one table or chart (or a family of them,
+//! one per level) with its text, a function `fn(&DamReport, &mut Doc)` that reads the runs
+//! ([`DamReport`], read once) and appends to the document ([`Doc`]: the Markdown and the charts
+//! written). A new section is a function (in its own file under `studies/dam/` if it is large)
+//! and one call here.
 
-use super::{DamKind, DamRun, Method, argmax};
+use super::{DamKind, DamParams, DamRun, Method};
 use crate::error::Error;
 use crate::report::{Axis, Chart, Series, Table, fmt_percent, fmt_sig, pareto_front};
 use crate::study::{KindReport, StudyResults};
@@ -38,14 +44,14 @@ pub struct Accuracy {
 fn mm(x: f64) -> String {
     fmt_sig(1e3 * x, 4)
 }
-fn mpa(x: f64) -> String {
+pub(super) fn mpa(x: f64) -> String {
     fmt_sig(1e-6 * x, 4)
 }
 /// A level as `1×`, `0.1×`, `2.5×` (3 decimals at most).
-fn lvl(x: f64) -> String {
+pub(super) fn lvl(x: f64) -> String {
     format!("{}×", lvl_num(x))
 }
-fn lvl_num(x: f64) -> f64 {
+pub(super) fn lvl_num(x: f64) -> f64 {
     (1e3 * x).round() / 1e3
 }
 /// " (stopped at t = … s)" for a run that stopped, else nothing: its maxima are up to there.
@@ -63,37 +69,137 @@ fn same(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-6 * b.abs().max(1e-12)
 }
 
-pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Error> {
-    let p = &kind.params;
-    let mut runs: Vec<DamRun> = Vec::new();
-    let mut unreadable = Vec::new();
-    for r in results.runs.iter().filter(|r| r.has_results()) {
-        match kind.run(r) {
-            Ok(x) => runs.push(x),
-            Err(e) => unreadable.push((r.spec.id.clone(), e.to_string())),
+/// The runs the report reads, sorted by level, method, mesh, and the levels they cover.
+pub struct DamReport<'a> {
+    pub kind: &'a DamKind,
+    pub results: &'a StudyResults<'a>,
+    pub runs: Vec<DamRun>,
+    /// Runs whose results could not be read: (id, why).
+    pub unreadable: Vec<(String, String)>,
+    /// Distinct levels, ascending.
+    pub levels: Vec<f64>,
+    /// The highest level.
+    pub top: Option<f64>,
+}
+
+impl<'a> DamReport<'a> {
+    /// Reads every run with results through [`DamKind::run`].
+    pub fn read(kind: &'a DamKind, results: &'a StudyResults<'a>) -> DamReport<'a> {
+        let mut runs: Vec<DamRun> = Vec::new();
+        let mut unreadable = Vec::new();
+        for r in results.runs.iter().filter(|r| r.has_results()) {
+            match kind.run(r) {
+                Ok(x) => runs.push(x),
+                Err(e) => unreadable.push((r.spec.id.clone(), e.to_string())),
+            }
+        }
+        runs.sort_by(|a, b| {
+            a.level
+                .total_cmp(&b.level)
+                .then(a.method.cmp(&b.method))
+                .then(a.mesh.cmp(&b.mesh))
+        });
+        let mut levels: Vec<f64> = runs.iter().map(|r| r.level).collect();
+        levels.dedup_by(|a, b| same(*a, *b));
+        let top = levels.last().copied();
+        DamReport {
+            kind,
+            results,
+            runs,
+            unreadable,
+            levels,
+            top,
         }
     }
-    runs.sort_by(|a, b| {
-        a.level
-            .total_cmp(&b.level)
-            .then(a.method.cmp(&b.method))
-            .then(a.mesh.cmp(&b.mesh))
-    });
-    let mut levels: Vec<f64> = runs.iter().map(|r| r.level).collect();
-    levels.dedup_by(|a, b| same(*a, *b));
-    let top = levels.last().copied();
-    let find = |level: f64, m: Method, main: bool| {
-        runs.iter()
+
+    pub fn params(&self) -> &DamParams {
+        &self.kind.params
+    }
+
+    /// The run at `level` with method `m`, on the main mesh (`main`) or another.
+    pub fn find(&self, level: f64, m: Method, main: bool) -> Option<&DamRun> {
+        let p = self.params();
+        self.runs
+            .iter()
             .find(|r| same(r.level, level) && r.method == m && r.is_main(p) == main)
-    };
-    let charts_dir = results.plan.out.join("charts");
-    let mut charts: Vec<PathBuf> = Vec::new();
-    let mut chart = |c: &Chart, stem: &str, md: &mut String| -> Result<(), Error> {
-        charts.push(c.write_png_svg(&charts_dir.join(stem))?.png);
-        let _ = writeln!(md, "\n![{}](charts/{stem}.svg)\n", c.title);
+    }
+}
+
+/// The report being written: its Markdown and the charts written so far.
+pub struct Doc {
+    pub md: String,
+    pub charts: Vec<PathBuf>,
+    /// Where the charts go (`<out>/charts`).
+    pub charts_dir: PathBuf,
+}
+
+impl Doc {
+    /// Writes `c` as `charts/<stem>.png` and `.svg` and embeds the SVG.
+    pub fn chart(&mut self, c: &Chart, stem: &str) -> Result<(), Error> {
+        self.charts
+            .push(c.write_png_svg(&self.charts_dir.join(stem))?.png);
+        let _ = writeln!(self.md, "\n![{}](charts/{stem}.svg)\n", c.title);
         Ok(())
+    }
+}
+
+pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Error> {
+    let r = DamReport::read(kind, results);
+    let mut doc = Doc {
+        md: String::new(),
+        charts: Vec::new(),
+        charts_dir: results.plan.out.join("charts"),
     };
-    let mut md = String::new();
+    heading_section(&r, &mut doc);
+    runs_section(&r, &mut doc);
+    per_joint_section(&r, &mut doc, Quantity::Opening)?;
+    per_joint_section(&r, &mut doc, Quantity::Slip)?;
+    largest_opening_section(&r, &mut doc);
+    largest_slip_section(&r, &mut doc);
+    stress_section(&r, &mut doc);
+    stress_against_seed_section(&r, &mut doc);
+    super::face_maps::face_maps_section(&r, &mut doc)?;
+    histories_section(&r, &mut doc)?;
+    let claims = claims(kind, &r.runs, &r.levels);
+    claims_section(&claims, &mut doc);
+    let acc = accuracy(&r);
+    speed_table_section(&r, &acc, &mut doc);
+    speed_chart_section(&r, &acc, &mut doc)?;
+    ntn_error_section(&r, &mut doc)?;
+    search_section(&r, &mut doc);
+    stopped_section(&r, &mut doc);
+
+    let mut lines = vec![format!(
+        "{} runs read at {} levels",
+        r.runs.len(),
+        r.levels.len()
+    )];
+    for c in &claims {
+        lines.push(format!(
+            "{}: {}",
+            match c.agreed {
+                Some(true) => "agreed",
+                Some(false) => "NOT agreed",
+                None => "not checked",
+            },
+            c.claim
+        ));
+    }
+    let json = serde_json::json!({ "runs": r.runs, "claims": claims, "accuracy": acc });
+    Ok(KindReport {
+        markdown: doc.md,
+        json,
+        charts: doc.charts,
+        lines,
+        unreadable: r.unreadable,
+        lists_failed: true,
+    })
+}
+
+/// Title and what the numbers are.
+fn heading_section(r: &DamReport, doc: &mut Doc) {
+    let p = r.params();
+    let md = &mut doc.md;
     let _ = writeln!(
         md,
         "# Arch dam study: contraction joints at 1×, 2×, 3× the design PGA, NTS against NTN\n"
@@ -101,15 +207,17 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     let _ = writeln!(
         md,
         "Generated by `jointquake study report` from `{}`; base scene `{}`. Design PGA {} g; a run's level is its PGA over it. Main mesh `{}`. Opening and slip are the largest over each joint's slave nodes and over the record (`histories/joint_<J>.csv`), in mm; stresses are the envelopes over time of the principal stresses of the elements under the faces (`envelope.json`, `envelope.vtu` per run), in MPa, tension positive. The seed's values (`seed` in the study file: {}) are for its own dam, whose shape it does not publish (docs/dam.md): compare trends and orders of magnitude, not digits.\n",
-        results.plan.study.display(),
-        results.study.scene.display(),
+        r.results.plan.study.display(),
+        r.results.study.scene.display(),
         fmt_sig(p.design_pga, 4),
         p.main_mesh,
         p.seed.source
     );
+}
 
-    // runs
-    let _ = writeln!(md, "## Runs\n");
+/// The runs read: method, level, mesh, status, time reached, wall time.
+fn runs_section(r: &DamReport, doc: &mut Doc) {
+    let _ = writeln!(doc.md, "## Runs\n");
     let mut t = Table::new([
         "run",
         "method",
@@ -119,7 +227,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         "record reached [s]",
         "wall time [s]",
     ]);
-    for r in &runs {
+    for r in &r.runs {
         let status = match &r.failed {
             Some(e) => format!("**failed**: {e}"),
             None => "finished".into(),
@@ -134,35 +242,105 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
             r.wall_time.map_or("–".into(), |w| fmt_sig(w, 4)),
         ]);
     }
-    md.push_str(&t.to_markdown());
+    doc.md.push_str(&t.to_markdown());
+}
 
-    // 1. openings and 2. slips per joint
-    for (what, key, seed_fig) in [("opening", 0, "13"), ("slip", 1, "14")] {
-        let _ = writeln!(
-            md,
-            "\n## Largest {what} of each joint (the seed's figure {seed_fig})\n"
-        );
-        for &l in &levels {
-            let mut c = Chart::new(
-                format!("Largest joint {what} over the record, {}", lvl(l)),
-                "joint (1 = left bank)",
-                format!("largest {what} [mm]"),
-            );
-            for m in [Method::Nts, Method::Ntn, Method::NtsLayer2] {
-                if let Some(r) = find(l, m, true) {
-                    let v = if key == 0 { &r.opening } else { &r.slip };
-                    c.series.push(Series::line_markers(
-                        m.name(),
-                        v.iter().enumerate().map(|(i, x)| ((i + 1) as f64, 1e3 * x)),
-                    ));
-                }
-            }
-            if !c.series.is_empty() {
-                chart(&c, &format!("{what}_per_joint_{}x", lvl_num(l)), &mut md)?;
-            }
+/// A joint quantity of the per-joint charts.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Quantity {
+    Opening,
+    Slip,
+}
+
+impl Quantity {
+    fn name(self) -> &'static str {
+        match self {
+            Quantity::Opening => "opening",
+            Quantity::Slip => "slip",
         }
     }
-    let _ = writeln!(md, "\n### Largest opening over all joints [mm]\n");
+    /// Per joint [m].
+    fn of(self, r: &DamRun) -> &[f64] {
+        match self {
+            Quantity::Opening => &r.opening,
+            Quantity::Slip => &r.slip,
+        }
+    }
+    /// The seed's figure of it.
+    fn seed_figure(self) -> &'static str {
+        match self {
+            Quantity::Opening => "13",
+            Quantity::Slip => "14",
+        }
+    }
+    /// (joint index, value) of the largest over the joints.
+    fn max(self, r: &DamRun) -> (usize, f64) {
+        match self {
+            Quantity::Opening => r.max_opening(),
+            Quantity::Slip => r.max_slip(),
+        }
+    }
+}
+
+/// The largest opening (or slip) of each joint, one chart per level (the seed's figure 13 / 14).
+fn per_joint_section(r: &DamReport, doc: &mut Doc, q: Quantity) -> Result<(), Error> {
+    let what = q.name();
+    let _ = writeln!(
+        doc.md,
+        "\n## Largest {what} of each joint (the seed's figure {})\n",
+        q.seed_figure()
+    );
+    for &l in &r.levels {
+        let mut c = Chart::new(
+            format!("Largest joint {what} over the record, {}", lvl(l)),
+            "joint number (1 = left bank) [-]",
+            format!("largest {what} [mm]"),
+        );
+        for m in [Method::Nts, Method::Ntn, Method::NtsLayer2] {
+            if let Some(run) = r.find(l, m, true) {
+                c.series.push(Series::line_markers(
+                    m.name(),
+                    q.of(run)
+                        .iter()
+                        .enumerate()
+                        .map(|(i, x)| ((i + 1) as f64, 1e3 * x)),
+                ));
+            }
+        }
+        if !c.series.is_empty() {
+            doc.chart(&c, &format!("{what}_per_joint_{}x", lvl_num(l)))?;
+        }
+    }
+    Ok(())
+}
+
+/// NTS's and NTN's (value with "stopped at", joint) of the largest `q` at level `l`, and
+/// NTS / NTN − 1 when both finished.
+fn nts_ntn_cells(r: &DamReport, l: f64, q: Quantity) -> [String; 5] {
+    let (nts, ntn) = (r.find(l, Method::Nts, true), r.find(l, Method::Ntn, true));
+    let cell = |x: Option<&DamRun>| {
+        x.map_or(("–".to_string(), "–".to_string()), |x| {
+            (
+                format!("{}{}", mm(q.max(x).1), stopped(x)),
+                x.joints[q.max(x).0].clone(),
+            )
+        })
+    };
+    let (a, ja) = cell(nts);
+    let (b, jb) = cell(ntn);
+    let d = match (nts, ntn) {
+        (Some(x), Some(y)) if x.failed.is_none() && y.failed.is_none() => {
+            fmt_percent(rel(q.max(x).1, q.max(y).1), 1)
+        }
+        _ => "–".into(),
+    };
+    [a, ja, b, jb, d]
+}
+
+/// The largest opening over all joints per level, NTS and NTN, ours and the seed's.
+fn largest_opening_section(r: &DamReport, doc: &mut Doc) {
+    let p = r.params();
+    let _ = writeln!(doc.md, "\n### Largest opening over all joints [mm]\n");
     let mut t = Table::new([
         "level",
         "NTS (ours)",
@@ -173,24 +351,8 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         "NTS (seed)",
         "NTN (seed)",
     ]);
-    for &l in &levels {
-        let (nts, ntn) = (find(l, Method::Nts, true), find(l, Method::Ntn, true));
-        let cell = |r: Option<&DamRun>| {
-            r.map_or(("–".to_string(), "–".to_string()), |r| {
-                (
-                    format!("{}{}", mm(r.max_opening().1), stopped(r)),
-                    r.joints[r.max_opening().0].clone(),
-                )
-            })
-        };
-        let (a, ja) = cell(nts);
-        let (b, jb) = cell(ntn);
-        let d = match (nts, ntn) {
-            (Some(x), Some(y)) if x.failed.is_none() && y.failed.is_none() => {
-                fmt_percent(rel(x.max_opening().1, y.max_opening().1), 1)
-            }
-            _ => "–".into(),
-        };
+    for &l in &r.levels {
+        let [a, ja, b, jb, d] = nts_ntn_cells(r, l, Quantity::Opening);
         let k = p.seed.levels.iter().position(|&s| same(s, l));
         let s = |v: &Vec<f64>| k.map_or("–".to_string(), |k| fmt_sig(v[k], 4));
         let _ = t.push_row([
@@ -204,8 +366,13 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
             s(&p.seed.opening_ntn_mm),
         ]);
     }
-    md.push_str(&t.to_markdown());
-    let _ = writeln!(md, "\n### Largest slip over all joints [mm]\n");
+    doc.md.push_str(&t.to_markdown());
+}
+
+/// The largest slip over all joints per level, NTS and NTN, and the seed's NTS / NTN.
+fn largest_slip_section(r: &DamReport, doc: &mut Doc) {
+    let p = r.params();
+    let _ = writeln!(doc.md, "\n### Largest slip over all joints [mm]\n");
     let mut t = Table::new([
         "level",
         "NTS (ours)",
@@ -215,34 +382,22 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         "NTS / NTN − 1 (ours)",
         "NTS / NTN − 1 (seed)",
     ]);
-    for &l in &levels {
-        let (nts, ntn) = (find(l, Method::Nts, true), find(l, Method::Ntn, true));
-        let cell = |r: Option<&DamRun>| {
-            r.map_or(("–".to_string(), "–".to_string()), |r| {
-                (
-                    format!("{}{}", mm(r.max_slip().1), stopped(r)),
-                    r.joints[r.max_slip().0].clone(),
-                )
-            })
-        };
-        let (a, ja) = cell(nts);
-        let (b, jb) = cell(ntn);
-        let d = match (nts, ntn) {
-            (Some(x), Some(y)) if x.failed.is_none() && y.failed.is_none() => {
-                fmt_percent(rel(x.max_slip().1, y.max_slip().1), 1)
-            }
-            _ => "–".into(),
-        };
-        let seed = if Some(l) == top && p.seed.levels.last().is_some_and(|&s| same(s, l)) {
+    for &l in &r.levels {
+        let [a, ja, b, jb, d] = nts_ntn_cells(r, l, Quantity::Slip);
+        let seed = if Some(l) == r.top && p.seed.levels.last().is_some_and(|&s| same(s, l)) {
             fmt_percent(p.seed.slip_nts_over_ntn, 1)
         } else {
             "–".into()
         };
         let _ = t.push_row([lvl(l), a, ja, b, jb, d, seed]);
     }
-    md.push_str(&t.to_markdown());
+    doc.md.push_str(&t.to_markdown());
+}
 
-    // 3. stresses
+/// The face stress extremes of every run with an envelope (the seed's figures 15–16).
+fn stress_section(r: &DamReport, doc: &mut Doc) {
+    let p = r.params();
+    let md = &mut doc.md;
     let _ = writeln!(
         md,
         "\n## Face stresses: envelopes of the principal stresses (the seed's figures 15–16)\n"
@@ -261,7 +416,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         "compression downstream",
         "largest tension: where (x, y, z) [m], t [s]",
     ]);
-    for r in runs.iter().filter(|r| r.stress.is_some()) {
+    for r in r.runs.iter().filter(|r| r.stress.is_some()) {
         let s = r.stress.as_ref().expect("filtered");
         let w = if s.upstream_tension.value >= s.downstream_tension.value {
             &s.upstream_tension
@@ -285,135 +440,158 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         ]);
     }
     md.push_str(&t.to_markdown());
-    if let Some(l) = top {
-        // the seed's stresses are at its highest level: quoted only against ours at that level
-        let seed_here = p.seed.levels.last().is_some_and(|&s| same(s, l));
-        let sd = |x: f64| {
-            if seed_here {
-                fmt_sig(x, 4)
-            } else {
-                "–".to_string()
-            }
-        };
-        let _ = writeln!(
-            md,
-            "\nAt {} against the seed [MPa]{}:\n",
-            lvl(l),
-            if seed_here {
-                ""
-            } else {
-                " (the seed's values are at another level: not quoted)"
-            }
-        );
-        let mut t = Table::new([
-            "",
-            "NTS (ours)",
-            "NTN (ours)",
-            "monolithic (ours)",
-            "NTS (seed)",
-            "NTN (seed)",
-        ]);
-        let g = |m: Method, f: &dyn Fn(&super::FaceStress) -> f64| {
-            find(l, m, true)
-                .and_then(|r| r.stress.as_ref())
-                .map_or("–".to_string(), |s| mpa(f(s)))
-        };
-        let _ = t.push_row([
-            "largest tension".to_string(),
-            g(Method::Nts, &|s| s.tension()),
-            g(Method::Ntn, &|s| s.tension()),
-            g(Method::Monolithic, &|s| s.tension()),
-            sd(p.seed.tension_nts_mpa),
-            sd(p.seed.tension_ntn_mpa),
-        ]);
-        let _ = t.push_row([
-            "largest compression".to_string(),
-            g(Method::Nts, &|s| s.compression()),
-            g(Method::Ntn, &|s| s.compression()),
-            g(Method::Monolithic, &|s| s.compression()),
-            sd(p.seed.compression_nts_mpa),
-            sd(p.seed.compression_ntn_mpa),
-        ]);
-        md.push_str(&t.to_markdown());
-        if let (Some(j), Some(mo)) = (
-            find(l, Method::Nts, true).and_then(|r| r.stress.as_ref()),
-            find(l, Method::Monolithic, true).and_then(|r| r.stress.as_ref()),
-        ) {
-            let _ = writeln!(
-                md,
-                "\nThe joints release arch tension: NTS's largest tension is {} of the monolithic dam's ({} against {} MPa).",
-                fmt_percent(j.tension() / mo.tension(), 0),
-                mpa(j.tension()),
-                mpa(mo.tension())
-            );
-        }
-    }
+}
 
-    // 4. histories
-    let _ = writeln!(md, "\n## Histories\n");
+/// The largest tension and compression at the highest level, NTS, NTN and monolithic against
+/// the seed's (quoted only when the seed's stresses are at that level).
+fn stress_against_seed_section(r: &DamReport, doc: &mut Doc) {
+    let Some(l) = r.top else { return };
+    let p = r.params();
+    let md = &mut doc.md;
+    // the seed's stresses are at its highest level: quoted only against ours at that level
+    let seed_here = p.seed.levels.last().is_some_and(|&s| same(s, l));
+    let sd = |x: f64| {
+        if seed_here {
+            fmt_sig(x, 4)
+        } else {
+            "–".to_string()
+        }
+    };
     let _ = writeln!(
         md,
+        "\nAt {} against the seed [MPa]{}:\n",
+        lvl(l),
+        if seed_here {
+            ""
+        } else {
+            " (the seed's values are at another level: not quoted)"
+        }
+    );
+    let mut t = Table::new([
+        "",
+        "NTS (ours)",
+        "NTN (ours)",
+        "monolithic (ours)",
+        "NTS (seed)",
+        "NTN (seed)",
+    ]);
+    let g = |m: Method, f: &dyn Fn(&super::FaceStress) -> f64| {
+        r.find(l, m, true)
+            .and_then(|r| r.stress.as_ref())
+            .map_or("–".to_string(), |s| mpa(f(s)))
+    };
+    let _ = t.push_row([
+        "largest tension".to_string(),
+        g(Method::Nts, &|s| s.tension()),
+        g(Method::Ntn, &|s| s.tension()),
+        g(Method::Monolithic, &|s| s.tension()),
+        sd(p.seed.tension_nts_mpa),
+        sd(p.seed.tension_ntn_mpa),
+    ]);
+    let _ = t.push_row([
+        "largest compression".to_string(),
+        g(Method::Nts, &|s| s.compression()),
+        g(Method::Ntn, &|s| s.compression()),
+        g(Method::Monolithic, &|s| s.compression()),
+        sd(p.seed.compression_nts_mpa),
+        sd(p.seed.compression_ntn_mpa),
+    ]);
+    md.push_str(&t.to_markdown());
+    if let (Some(j), Some(mo)) = (
+        r.find(l, Method::Nts, true).and_then(|r| r.stress.as_ref()),
+        r.find(l, Method::Monolithic, true)
+            .and_then(|r| r.stress.as_ref()),
+    ) {
+        let _ = writeln!(
+            md,
+            "\nThe joints release arch tension: NTS's largest tension is {} of the monolithic dam's ({} against {} MPa).",
+            fmt_percent(j.tension() / mo.tension(), 0),
+            mpa(j.tension()),
+            mpa(mo.tension())
+        );
+    }
+}
+
+/// Crest radial displacement and the worst joint's opening over time, per level, with the
+/// crest peaks.
+fn histories_section(r: &DamReport, doc: &mut Doc) -> Result<(), Error> {
+    let p = r.params();
+    let _ = writeln!(doc.md, "\n## Histories\n");
+    let _ = writeln!(
+        doc.md,
         "Crest radial displacement (positive downstream, relative to the base, from the static state) at the crown (`{}`) and the quarter points (`{}`, `{}`), and the largest opening of the joint with the largest opening.\n",
         p.monitors.crown, p.monitors.quarter_left, p.monitors.quarter_right
     );
-    for &l in &levels {
-        let mut c = Chart::new(
-            format!("Crest radial displacement, {}", lvl(l)),
-            "t [s]",
-            "radial displacement [mm]",
-        );
-        let mut o = Chart::new(
-            format!("Opening of the worst joint, {}", lvl(l)),
-            "t [s]",
-            "largest opening [mm]",
-        );
-        for m in [Method::Nts, Method::Ntn] {
-            if let Some(r) = find(l, m, true) {
-                for (name, h) in &r.crest {
-                    c.series.push(Series::line(
-                        format!("{} {name}", m.name()),
-                        h.iter().map(|&(t, u)| (t, 1e3 * u)),
-                    ));
-                }
-                let (k, _) = r.max_opening();
-                o.series.push(Series::line(
-                    format!("{} {}", m.name(), r.joints[k]),
-                    r.worst_joint_history.iter().map(|&(t, u)| (t, 1e3 * u)),
+    for &l in &r.levels {
+        histories_charts(r, l, doc)?;
+        crest_peaks_table(r, l, doc);
+    }
+    Ok(())
+}
+
+/// The crest and worst-joint histories at level `l` (NTS and NTN on the main mesh).
+fn histories_charts(r: &DamReport, l: f64, doc: &mut Doc) -> Result<(), Error> {
+    let mut c = Chart::new(
+        format!("Crest radial displacement, {}", lvl(l)),
+        "t [s]",
+        "radial displacement [mm]",
+    );
+    let mut o = Chart::new(
+        format!("Opening of the worst joint, {}", lvl(l)),
+        "t [s]",
+        "largest opening [mm]",
+    );
+    for m in [Method::Nts, Method::Ntn] {
+        if let Some(r) = r.find(l, m, true) {
+            for (name, h) in &r.crest {
+                c.series.push(Series::line(
+                    format!("{} {name}", m.name()),
+                    h.iter().map(|&(t, u)| (t, 1e3 * u)),
                 ));
             }
-        }
-        if !c.series.is_empty() {
-            chart(&c, &format!("crest_{}x", lvl_num(l)), &mut md)?;
-            chart(&o, &format!("worst_joint_{}x", lvl_num(l)), &mut md)?;
-        }
-        let mut t = Table::new([
-            "run",
-            "crown: largest |u_r| [mm]",
-            "left quarter",
-            "right quarter",
-        ]);
-        for m in [Method::Nts, Method::Ntn] {
-            if let Some(r) = find(l, m, true) {
-                let peak =
-                    |h: &Vec<(f64, f64)>| mm(h.iter().map(|x| x.1.abs()).fold(0.0, f64::max));
-                let _ = t.push_row([
-                    format!("`{}`{}", r.id, stopped(r)),
-                    peak(&r.crest[0].1),
-                    peak(&r.crest[1].1),
-                    peak(&r.crest[2].1),
-                ]);
-            }
-        }
-        if !t.rows().is_empty() {
-            md.push_str(&t.to_markdown());
+            let (k, _) = r.max_opening();
+            o.series.push(Series::line(
+                format!("{} {}", m.name(), r.joints[k]),
+                r.worst_joint_history.iter().map(|&(t, u)| (t, 1e3 * u)),
+            ));
         }
     }
+    if !c.series.is_empty() {
+        doc.chart(&c, &format!("crest_{}x", lvl_num(l)))?;
+        doc.chart(&o, &format!("worst_joint_{}x", lvl_num(l)))?;
+    }
+    Ok(())
+}
 
-    // 5. claims
-    let claims = claims(kind, &runs, &levels);
-    let _ = writeln!(md, "\n## The seed's claims against our numbers\n");
+/// The largest crest radial displacements at level `l`.
+fn crest_peaks_table(r: &DamReport, l: f64, doc: &mut Doc) {
+    let mut t = Table::new([
+        "run",
+        "crown: largest |u_r| [mm]",
+        "left quarter",
+        "right quarter",
+    ]);
+    for m in [Method::Nts, Method::Ntn] {
+        if let Some(r) = r.find(l, m, true) {
+            let peak = |h: &Vec<(f64, f64)>| mm(h.iter().map(|x| x.1.abs()).fold(0.0, f64::max));
+            let _ = t.push_row([
+                format!("`{}`{}", r.id, stopped(r)),
+                peak(&r.crest[0].1),
+                peak(&r.crest[1].1),
+                peak(&r.crest[2].1),
+            ]);
+        }
+    }
+    if !t.rows().is_empty() {
+        doc.md.push_str(&t.to_markdown());
+    }
+}
+
+/// The seed's claims with our numbers and the verdicts.
+fn claims_section(claims: &[Claim], doc: &mut Doc) {
+    let _ = writeln!(doc.md, "\n## The seed's claims against our numbers\n");
     let mut t = Table::new(["claim (seed)", "ours", "verdict"]);
-    for c in &claims {
+    for c in claims {
         let _ = t.push_row([
             c.claim.clone(),
             c.ours.clone(),
@@ -424,46 +602,62 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
             },
         ]);
     }
-    md.push_str(&t.to_markdown());
+    doc.md.push_str(&t.to_markdown());
+}
 
-    // 6. speed against accuracy
+/// Every finished run against its level's reference (NTS-Layer2 on the main mesh, else NTS).
+fn accuracy(r: &DamReport) -> Vec<Accuracy> {
     let mut acc: Vec<Accuracy> = Vec::new();
-    for &l in &levels {
-        let reference = find(l, Method::NtsLayer2, true)
-            .or(find(l, Method::Nts, true))
+    for &l in &r.levels {
+        let reference = r
+            .find(l, Method::NtsLayer2, true)
+            .or(r.find(l, Method::Nts, true))
             .filter(|r| r.failed.is_none());
         let Some(rf) = reference else { continue };
-        for r in runs
+        for x in r
+            .runs
             .iter()
-            .filter(|r| same(r.level, l) && r.id != rf.id && r.failed.is_none())
+            .filter(|x| same(x.level, l) && x.id != rf.id && x.failed.is_none())
         {
-            let eo = rel(r.max_opening().1, rf.max_opening().1).abs();
-            let es = rel(r.max_slip().1, rf.max_slip().1).abs();
-            let (et, ec) = match (&r.stress, &rf.stress) {
-                (Some(a), Some(b)) => (
-                    Some(rel(a.tension(), b.tension()).abs()),
-                    Some(rel(a.compression(), b.compression()).abs()),
-                ),
-                _ => (None, None),
-            };
-            let error = [Some(eo), Some(es), et, ec]
-                .into_iter()
-                .flatten()
-                .filter(|e| e.is_finite())
-                .fold(0.0, f64::max);
-            acc.push(Accuracy {
-                id: r.id.clone(),
-                level: l,
-                reference: rf.id.clone(),
-                wall_time: r.wall_time.unwrap_or(f64::NAN),
-                error_opening: eo,
-                error_slip: es,
-                error_tension: et,
-                error_compression: ec,
-                error,
-            });
+            acc.push(accuracy_of(x, rf, l));
         }
     }
+    acc
+}
+
+/// Run `x`'s errors against reference `rf` at level `l`.
+fn accuracy_of(x: &DamRun, rf: &DamRun, l: f64) -> Accuracy {
+    let eo = rel(x.max_opening().1, rf.max_opening().1).abs();
+    let es = rel(x.max_slip().1, rf.max_slip().1).abs();
+    let (et, ec) = match (&x.stress, &rf.stress) {
+        (Some(a), Some(b)) => (
+            Some(rel(a.tension(), b.tension()).abs()),
+            Some(rel(a.compression(), b.compression()).abs()),
+        ),
+        _ => (None, None),
+    };
+    let error = [Some(eo), Some(es), et, ec]
+        .into_iter()
+        .flatten()
+        .filter(|e| e.is_finite())
+        .fold(0.0, f64::max);
+    Accuracy {
+        id: x.id.clone(),
+        level: l,
+        reference: rf.id.clone(),
+        wall_time: x.wall_time.unwrap_or(f64::NAN),
+        error_opening: eo,
+        error_slip: es,
+        error_tension: et,
+        error_compression: ec,
+        error,
+    }
+}
+
+/// The errors of every cheaper run and the cheapest within `enough` per level.
+fn speed_table_section(r: &DamReport, acc: &[Accuracy], doc: &mut Doc) {
+    let p = r.params();
+    let md = &mut doc.md;
     let _ = writeln!(md, "\n## Speed against accuracy\n");
     let _ = writeln!(
         md,
@@ -482,7 +676,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         "error",
     ]);
     let o = |x: Option<f64>| x.map_or("–".into(), |v| fmt_percent(v, 1));
-    for a in &acc {
+    for a in acc {
         let _ = t.push_row([
             lvl(a.level),
             format!("`{}`", a.id),
@@ -497,7 +691,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     }
     md.push_str(&t.to_markdown());
     let _ = writeln!(md);
-    for &l in &levels {
+    for &l in &r.levels {
         let best = acc
             .iter()
             .filter(|a| same(a.level, l) && a.error <= p.enough && a.wall_time.is_finite())
@@ -525,43 +719,48 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
             None => {}
         }
     }
-    if let Some(l) = top {
-        let pts: Vec<&Accuracy> = acc
-            .iter()
-            .filter(|a| {
-                same(a.level, l) && a.wall_time.is_finite() && a.wall_time > 0.0 && a.error > 0.0
-            })
-            .collect();
-        if !pts.is_empty() {
-            let xy: Vec<(f64, f64)> = pts.iter().map(|a| (a.wall_time, a.error)).collect();
-            let front = pareto_front(&xy);
-            let mut c = Chart::new(
-                format!("Speed against accuracy at {}", lvl(l)),
-                "wall time [s]",
-                "error against the reference",
-            );
-            c.x_axis = Axis::Log;
-            c.y_axis = Axis::Log;
-            for (i, a) in pts.iter().enumerate() {
-                c.series.push(Series::markers(a.id.clone(), [xy[i]]));
-            }
-            c.series
-                .push(Series::line("Pareto front", front.iter().map(|&i| xy[i])));
-            chart(&c, "speed_accuracy", &mut md)?;
-            let dropped = acc.iter().filter(|a| same(a.level, l)).count() - pts.len();
-            if dropped > 0 {
-                let _ = writeln!(
-                    md,
-                    "({dropped} run(s) with zero error or no wall time are in the table but cannot be drawn on log axes.)"
-                );
-            }
-        }
-    }
+}
 
-    // 7. where methods fail
-    let _ = writeln!(md, "\n## Where methods fail\n");
+/// Wall time against error at the highest level, with the Pareto front (log-log).
+fn speed_chart_section(r: &DamReport, acc: &[Accuracy], doc: &mut Doc) -> Result<(), Error> {
+    let Some(l) = r.top else { return Ok(()) };
+    let pts: Vec<&Accuracy> = acc
+        .iter()
+        .filter(|a| same(a.level, l) && a.wall_time.is_finite() && a.wall_time > 0.0 && a.error > 0.0)
+        .collect();
+    if pts.is_empty() {
+        return Ok(());
+    }
+    let xy: Vec<(f64, f64)> = pts.iter().map(|a| (a.wall_time, a.error)).collect();
+    let front = pareto_front(&xy);
+    let mut c = Chart::new(
+        format!("Speed against accuracy at {}", lvl(l)),
+        "wall time [s]",
+        "relative error against the reference [-]",
+    );
+    c.x_axis = Axis::Log;
+    c.y_axis = Axis::Log;
+    for (i, a) in pts.iter().enumerate() {
+        c.series.push(Series::markers(a.id.clone(), [xy[i]]));
+    }
+    c.series
+        .push(Series::line("Pareto front", front.iter().map(|&i| xy[i])));
+    doc.chart(&c, "speed_accuracy")?;
+    let dropped = acc.iter().filter(|a| same(a.level, l)).count() - pts.len();
+    if dropped > 0 {
+        let _ = writeln!(
+            doc.md,
+            "({dropped} run(s) with zero error or no wall time are in the table but cannot be drawn on log axes.)"
+        );
+    }
+    Ok(())
+}
+
+/// NTN − NTS per joint against the joint's NTS slip (where node-to-node fails).
+fn ntn_error_section(r: &DamReport, doc: &mut Doc) -> Result<(), Error> {
+    let _ = writeln!(doc.md, "\n## Where methods fail\n");
     let _ = writeln!(
-        md,
+        doc.md,
         "NTN against NTS per joint: the difference of the largest opening and slip against the joint's largest NTS slip (a node-to-node pair is exact only while the nodes stay facing each other).\n"
     );
     let mut c = Chart::new(
@@ -574,8 +773,8 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         "largest NTS slip [mm]",
         "NTN − NTS largest slip [mm]",
     );
-    for &l in &levels {
-        if let (Some(a), Some(b)) = (find(l, Method::Nts, true), find(l, Method::Ntn, true)) {
+    for &l in &r.levels {
+        if let (Some(a), Some(b)) = (r.find(l, Method::Nts, true), r.find(l, Method::Ntn, true)) {
             // both over the whole record: a stopped run's maxima end earlier
             if a.joints == b.joints && a.failed.is_none() && b.failed.is_none() {
                 c.series.push(Series::markers(
@@ -591,146 +790,157 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
         }
     }
     if !c.series.is_empty() {
-        chart(&c, "ntn_error_opening", &mut md)?;
-        chart(&cs, "ntn_error_slip", &mut md)?;
+        doc.chart(&c, "ntn_error_opening")?;
+        doc.chart(&cs, "ntn_error_slip")?;
     }
-    if let Some(l) = top {
-        let cols: Vec<&DamRun> = runs
-            .iter()
-            .filter(|r| {
-                same(r.level, l) && r.diagnostics.is_some() && r.method != Method::Monolithic
-            })
-            .collect();
-        if let Some(first) = cols.first() {
-            let _ = writeln!(
-                md,
-                "Search and Gauss–Seidel per joint at {} (node-steps lost / Layer2 widenings / fresh searches / largest sweeps / unconverged steps; never silent):\n",
-                lvl(l)
-            );
-            let mut head = vec!["joint".to_string()];
-            head.extend(
-                cols.iter()
-                    .map(|r| format!("{} {}", r.method.name(), r.mesh)),
-            );
-            let mut t = Table::new(head);
-            for (k, j) in first.joints.iter().enumerate() {
-                let mut row = vec![j.clone()];
-                for r in &cols {
-                    let d = r
-                        .diagnostics
-                        .as_ref()
-                        .and_then(|d| r.joints.iter().position(|x| x == j).map(|i| &d[i]));
-                    row.push(d.map_or("–".into(), |d| {
-                        format!(
-                            "{} / {} / {} / {} / {}",
-                            d.lost,
-                            d.widened_layer2,
-                            d.fresh_searches,
-                            d.max_sweeps,
-                            d.unconverged_steps
-                        )
-                    }));
-                }
-                let _ = k;
-                let _ = t.push_row(row);
-            }
-            md.push_str(&t.to_markdown());
-        }
-    }
-    let failed: Vec<&DamRun> = runs.iter().filter(|r| r.failed.is_some()).collect();
-    if !failed.is_empty() {
-        let _ = writeln!(
-            md,
-            "\nRuns that stopped (their joint maxima above are up to where they stopped; no stress envelope):\n"
-        );
-        for r in failed {
-            let _ = writeln!(
-                md,
-                "- `{}` at t = {} s: {}",
-                r.id,
-                fmt_sig(r.t_end, 4),
-                r.failed.as_deref().unwrap_or("")
-            );
-        }
-    }
+    Ok(())
+}
 
-    let mut lines = vec![format!(
-        "{} runs read at {} levels",
-        runs.len(),
-        levels.len()
-    )];
-    for c in &claims {
-        lines.push(format!(
-            "{}: {}",
-            match c.agreed {
-                Some(true) => "agreed",
-                Some(false) => "NOT agreed",
-                None => "not checked",
-            },
-            c.claim
-        ));
+/// Search and Gauss–Seidel diagnostics per joint at the highest level, one column per run.
+fn search_section(r: &DamReport, doc: &mut Doc) {
+    let Some(l) = r.top else { return };
+    let cols: Vec<&DamRun> = r
+        .runs
+        .iter()
+        .filter(|r| same(r.level, l) && r.diagnostics.is_some() && r.method != Method::Monolithic)
+        .collect();
+    let Some(first) = cols.first() else { return };
+    let _ = writeln!(
+        doc.md,
+        "Search and Gauss–Seidel per joint at {} (node-steps lost / Layer2 widenings / fresh searches / largest sweeps / unconverged steps; never silent):\n",
+        lvl(l)
+    );
+    let mut head = vec!["joint".to_string()];
+    head.extend(
+        cols.iter()
+            .map(|r| format!("{} {}", r.method.name(), r.mesh)),
+    );
+    let mut t = Table::new(head);
+    for j in &first.joints {
+        let mut row = vec![j.clone()];
+        for r in &cols {
+            let d = r
+                .diagnostics
+                .as_ref()
+                .and_then(|d| r.joints.iter().position(|x| x == j).map(|i| &d[i]));
+            row.push(d.map_or("–".into(), |d| {
+                format!(
+                    "{} / {} / {} / {} / {}",
+                    d.lost, d.widened_layer2, d.fresh_searches, d.max_sweeps, d.unconverged_steps
+                )
+            }));
+        }
+        let _ = t.push_row(row);
     }
-    let json = serde_json::json!({ "runs": runs, "claims": claims, "accuracy": acc });
-    Ok(KindReport {
-        markdown: md,
-        json,
-        charts,
-        lines,
-        unreadable,
-        lists_failed: true,
-    })
+    doc.md.push_str(&t.to_markdown());
+}
+
+/// The runs that stopped, with where and why.
+fn stopped_section(r: &DamReport, doc: &mut Doc) {
+    let failed: Vec<&DamRun> = r.runs.iter().filter(|r| r.failed.is_some()).collect();
+    if failed.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        doc.md,
+        "\nRuns that stopped (their joint maxima above are up to where they stopped; no stress envelope):\n"
+    );
+    for r in failed {
+        let _ = writeln!(
+            doc.md,
+            "- `{}` at t = {} s: {}",
+            r.id,
+            fmt_sig(r.t_end, 4),
+            r.failed.as_deref().unwrap_or("")
+        );
+    }
 }
 
 /// The seed's qualitative claims, each with the rule that decides it.
 fn claims(kind: &DamKind, runs: &[DamRun], levels: &[f64]) -> Vec<Claim> {
-    let p = &kind.params;
-    let find = |level: f64, m: Method| {
-        runs.iter()
-            .find(|r| same(r.level, level) && r.method == m && r.is_main(p) && r.failed.is_none())
+    let c = ClaimRuns {
+        p: &kind.params,
+        runs,
+        levels,
     };
-    let mut out = Vec::new();
-    let top = levels.last().copied();
-    // NTS ≈ NTN below the top level
-    let low: Vec<f64> = levels.iter().copied().filter(|&l| Some(l) != top).collect();
-    let mut ours = Vec::new();
-    let mut ok = Some(true);
-    for &l in &low {
-        match (find(l, Method::Nts), find(l, Method::Ntn)) {
-            (Some(a), Some(b)) => {
-                let (eo, es) = (
-                    rel(b.max_opening().1, a.max_opening().1),
-                    rel(b.max_slip().1, a.max_slip().1),
-                );
-                ours.push(format!(
-                    "{}: NTN − NTS opening {}, slip {}",
-                    lvl(l),
-                    fmt_percent(eo, 1),
-                    fmt_percent(es, 1)
-                ));
-                if eo.abs() > p.enough || es.abs() > p.enough {
-                    ok = ok.map(|_| false);
+    let mut out = vec![c.nts_near_ntn_below_top()];
+    if let Some(t) = levels.last().copied() {
+        out.push(c.openings_grow_faster(t));
+        out.push(c.openings_more_uniform(t));
+        out.push(c.largest_opening_left(t));
+        out.extend(c.nts_above_ntn(t));
+    }
+    out
+}
+
+/// The finished main-mesh runs the claims read.
+struct ClaimRuns<'a> {
+    p: &'a DamParams,
+    runs: &'a [DamRun],
+    levels: &'a [f64],
+}
+
+impl ClaimRuns<'_> {
+    fn find(&self, level: f64, m: Method) -> Option<&DamRun> {
+        self.runs.iter().find(|r| {
+            same(r.level, level) && r.method == m && r.is_main(self.p) && r.failed.is_none()
+        })
+    }
+
+    /// The levels below the highest.
+    fn low(&self) -> Vec<f64> {
+        let top = self.levels.last().copied();
+        self.levels
+            .iter()
+            .copied()
+            .filter(|&l| Some(l) != top)
+            .collect()
+    }
+
+    /// NTS ≈ NTN below the top level.
+    fn nts_near_ntn_below_top(&self) -> Claim {
+        let low = self.low();
+        let mut ours = Vec::new();
+        let mut ok = Some(true);
+        for &l in &low {
+            match (self.find(l, Method::Nts), self.find(l, Method::Ntn)) {
+                (Some(a), Some(b)) => {
+                    let (eo, es) = (
+                        rel(b.max_opening().1, a.max_opening().1),
+                        rel(b.max_slip().1, a.max_slip().1),
+                    );
+                    ours.push(format!(
+                        "{}: NTN − NTS opening {}, slip {}",
+                        lvl(l),
+                        fmt_percent(eo, 1),
+                        fmt_percent(es, 1)
+                    ));
+                    if eo.abs() > self.p.enough || es.abs() > self.p.enough {
+                        ok = ok.map(|_| false);
+                    }
                 }
+                _ => ok = None,
             }
-            _ => ok = None,
+        }
+        if low.is_empty() {
+            ok = None;
+        }
+        Claim {
+            claim: format!(
+                "NTS ≈ NTN below the highest level (rule: largest opening and slip within {})",
+                fmt_percent(self.p.enough, 0)
+            ),
+            ours: ours.join("; "),
+            agreed: ok,
         }
     }
-    if low.is_empty() {
-        ok = None;
-    }
-    out.push(Claim {
-        claim: format!(
-            "NTS ≈ NTN below the highest level (rule: largest opening and slip within {})",
-            fmt_percent(p.enough, 0)
-        ),
-        ours: ours.join("; "),
-        agreed: ok,
-    });
-    if let Some(t) = top {
-        let prev = low.last().copied();
-        // openings grow faster than the input
-        let c = match (
-            prev.and_then(|l| find(l, Method::Nts).map(|r| (l, r))),
-            find(t, Method::Nts),
+
+    /// Openings grow faster than the input from the level below the top to the top.
+    fn openings_grow_faster(&self, t: f64) -> Claim {
+        let prev = self.low().last().copied();
+        match (
+            prev.and_then(|l| self.find(l, Method::Nts).map(|r| (l, r))),
+            self.find(t, Method::Nts),
         ) {
             (Some((l, a)), Some(b)) => {
                 let g = b.max_opening().1 / a.max_opening().1;
@@ -741,22 +951,26 @@ fn claims(kind: &DamKind, runs: &[DamRun], levels: &[f64]) -> Vec<Claim> {
                 ours: String::new(),
                 agreed: None,
             },
-        };
-        out.push(c);
-        // more uniform across joints
+        }
+    }
+
+    /// Openings more uniform across joints at the top level than at the lowest.
+    fn openings_more_uniform(&self, t: f64) -> Claim {
         let cv = |r: &DamRun| {
             let n = r.opening.len() as f64;
             let mean = r.opening.iter().sum::<f64>() / n;
             (r.opening.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n).sqrt() / mean
         };
-        let lowest = levels.first().copied();
-        let c = match (lowest.filter(|&l| Some(l) != top).and_then(|l| find(l, Method::Nts).map(|r| (l, r))), find(t, Method::Nts)) {
+        let lowest = self.levels.first().copied();
+        match (lowest.filter(|&l| l != t).and_then(|l| self.find(l, Method::Nts).map(|r| (l, r))), self.find(t, Method::Nts)) {
             (Some((l, a)), Some(b)) => Claim { claim: "at the highest level openings are more uniform across joints (rule: smaller coefficient of variation of the NTS openings than at the lowest level)".into(), ours: format!("CoV {} at {}, {} at {}", fmt_sig(cv(a), 3), lvl(l), fmt_sig(cv(b), 3), lvl(t)), agreed: Some(cv(b) < cv(a)) },
             _ => Claim { claim: "at the highest level openings are more uniform across joints".into(), ours: String::new(), agreed: None },
-        };
-        out.push(c);
-        // largest opening near the left abutment
-        let c = match find(t, Method::Nts) {
+        }
+    }
+
+    /// The largest opening near the left abutment (the left third of the joints).
+    fn largest_opening_left(&self, t: f64) -> Claim {
+        match self.find(t, Method::Nts) {
             Some(r) => {
                 let (k, _) = r.max_opening();
                 let third = r.opening.len().div_ceil(3);
@@ -773,10 +987,12 @@ fn claims(kind: &DamKind, runs: &[DamRun], levels: &[f64]) -> Vec<Claim> {
                 ours: String::new(),
                 agreed: None,
             },
-        };
-        out.push(c);
-        // NTS above NTN at the top level
-        let (a, b) = (find(t, Method::Nts), find(t, Method::Ntn));
+        }
+    }
+
+    /// NTS above NTN at the top level: opening, slip, tension, compression.
+    fn nts_above_ntn(&self, t: f64) -> Vec<Claim> {
+        let (a, b) = (self.find(t, Method::Nts), self.find(t, Method::Ntn));
         let q: [(&str, Box<dyn Fn(&DamRun) -> Option<f64>>); 4] = [
             (
                 "largest opening",
@@ -792,8 +1008,8 @@ fn claims(kind: &DamKind, runs: &[DamRun], levels: &[f64]) -> Vec<Claim> {
                 Box::new(|r: &DamRun| r.stress.as_ref().map(|s| -s.compression())),
             ),
         ];
-        for (name, f) in q.iter() {
-            let c = match (a.and_then(|r| f(r)), b.and_then(|r| f(r))) {
+        q.iter()
+            .map(|(name, f)| match (a.and_then(|r| f(r)), b.and_then(|r| f(r))) {
                 (Some(x), Some(y)) => Claim {
                     claim: format!("NTS above NTN at {}: {name}", lvl(t)),
                     ours: format!("NTS / NTN − 1 = {}", fmt_percent(rel(x, y), 1)),
@@ -804,10 +1020,7 @@ fn claims(kind: &DamKind, runs: &[DamRun], levels: &[f64]) -> Vec<Claim> {
                     ours: String::new(),
                     agreed: None,
                 },
-            };
-            out.push(c);
-        }
+            })
+            .collect()
     }
-    let _ = argmax;
-    out
 }
