@@ -18,6 +18,7 @@
 //! tension positive; crest radial displacement positive downstream, along the horizontal
 //! normal of the upstream crest arch y = x² / (2 Rc) at the monitor, (−x/Rc, 1, 0) normalised.
 
+pub mod convergence;
 pub mod report;
 pub mod static_table;
 
