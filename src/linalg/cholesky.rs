@@ -1,6 +1,7 @@
 //! Sparse Cholesky factorisation A = L Lᵀ with faer: the symbolic analysis (AMD ordering,
-//! supernodal or simplicial structure) once, the numeric factorisation once, then solves
-//! that reuse one scratch buffer (no allocation per solve).
+//! supernodal or simplicial structure) once, the numeric factorisation once (or again, for a
+//! matrix of the same pattern: [`SparseCholesky::refactor`]), then solves that reuse one
+//! scratch buffer (no allocation per solve).
 
 use super::{Csc, LinalgError};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -16,6 +17,9 @@ pub struct SparseCholesky {
     scratch: MemBuffer,
     scratch_cols: usize,
     par: Par,
+    /// Entries of the matrix the symbolic analysis was made for (a refactorisation must have
+    /// the same pattern).
+    pattern_nnz: usize,
 }
 
 impl std::fmt::Debug for SparseCholesky {
@@ -39,17 +43,26 @@ impl SparseCholesky {
         let mut values = Vec::new();
         values.try_reserve_exact(symbolic.len_val()).map_err(|_| oom())?;
         values.resize(symbolic.len_val(), 0.0);
-        let mut stack = MemBuffer::try_new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default())).map_err(|_| oom())?;
-        let res = symbolic.factorize_numeric_llt::<f64>(&mut values, m, Side::Lower, Default::default(), par, MemStack::new(&mut stack), Default::default());
-        match res {
-            Ok(_) => {}
-            Err(NumericLltError::NonPositivePivot { index }) => {
-                return Err(LinalgError::NotPositiveDefinite { what: what.to_string(), pivot: index, n });
-            }
-        }
-        drop(stack);
         let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, par)).map_err(|_| oom())?;
-        Ok(SparseCholesky { symbolic, values, scratch, scratch_cols: 1, par })
+        let mut chol = SparseCholesky { symbolic, values, scratch, scratch_cols: 1, par, pattern_nnz: a.nnz() };
+        chol.refactor(a, what)?;
+        Ok(chol)
+    }
+
+    /// Factorise `a` again, a matrix with the pattern of the one this was made for (the
+    /// symbolic analysis, its ordering and the factor's memory are reused: only the numeric
+    /// factorisation is done). A different pattern is an error.
+    pub fn refactor(&mut self, a: &Csc, what: &str) -> Result<(), LinalgError> {
+        let n = self.n();
+        if a.n_rows != n || a.n_cols != n || a.nnz() != self.pattern_nnz {
+            return Err(LinalgError::Invalid(format!("{what}: refactorising a {}×{} matrix with {} entries on the analysis of a {n}×{n} one with {}", a.n_rows, a.n_cols, a.nnz(), self.pattern_nnz)));
+        }
+        let mut stack = MemBuffer::try_new(self.symbolic.factorize_numeric_llt_scratch::<f64>(self.par, Default::default())).map_err(|_| LinalgError::OutOfMemory { what: what.to_string(), n })?;
+        let res = self.symbolic.factorize_numeric_llt::<f64>(&mut self.values, a.as_faer(), Side::Lower, Default::default(), self.par, MemStack::new(&mut stack), Default::default());
+        match res {
+            Ok(_) => Ok(()),
+            Err(NumericLltError::NonPositivePivot { index }) => Err(LinalgError::NotPositiveDefinite { what: what.to_string(), pivot: index, n }),
+        }
     }
 
     /// Order of the matrix.
@@ -112,6 +125,30 @@ mod tests {
         let err = r.iter().zip(&b).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
         let nb = b.iter().map(|v| v * v).sum::<f64>().sqrt();
         assert!(err < 1e-10 * nb, "residual {err} vs {nb}");
+    }
+
+    #[test]
+    fn refactorisation_reuses_the_analysis_and_checks_the_pattern() {
+        // K x = b, then 2 K refactorised on the same analysis: x/2 to round-off (1e-12
+        // relative); a matrix of another pattern is refused, not factorised wrongly
+        let m = crate::linalg::assemble::tests::box_model(true, [3, 2, 2]);
+        let k = stiffness(&m, &[true]);
+        let n = 3 * m.n_nodes();
+        let (map, nf) = dof_map(n, |d| m.is_free(d / 3, d % 3));
+        let mut kff = restrict(&k, &map, nf, &map, nf);
+        let mut ch = SparseCholesky::factor(&kff, "test", Par::Seq).unwrap();
+        let b: Vec<f64> = (0..nf).map(|i| (i as f64 * 0.11).cos()).collect();
+        let mut x1 = b.clone();
+        ch.solve_in_place(&mut x1);
+        kff.val.iter_mut().for_each(|v| *v *= 2.0);
+        ch.refactor(&kff, "test").unwrap();
+        let mut x2 = b.clone();
+        ch.solve_in_place(&mut x2);
+        let scale = x1.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        assert!(x1.iter().zip(&x2).all(|(a, b)| (a - 2.0 * b).abs() < 1e-12 * scale));
+        let (map2, nf2) = dof_map(n, |d| m.is_free(d / 3, d % 3) && d != 3 * m.n_nodes() - 1);
+        let other = restrict(&k, &map2, nf2, &map2, nf2);
+        assert!(matches!(ch.refactor(&other, "other"), Err(LinalgError::Invalid(_))));
     }
 
     #[test]

@@ -1,10 +1,11 @@
 //! Sparse linear algebra of the model: the global stiffness K as a faer sparse matrix, its
 //! restriction to a set of unknowns, a sparse Cholesky factorisation (symbolic once, numeric
-//! once, solves repeated), and the lowest modes of K φ = ω² M φ.
+//! once or again on the same pattern, solves repeated), restarted GMRES for unsymmetric
+//! systems preconditioned by such a factorisation, and the lowest modes of K φ = ω² M φ.
 //!
 //! Owns: nothing that changes during a run. Inputs: the immutable [`Model`](crate::model::Model)
 //! (its element kernels: Hooke's law and the B matrices are not written again here).
-//! Outputs: [`Csc`] matrices, [`SparseCholesky`], [`Modes`].
+//! Outputs: [`Csc`] matrices, [`SparseCholesky`], [`Modes`], [`gmres_into`]'s solutions.
 //!
 //! Conventions (written once, here):
 //! - Degrees of freedom are the model's, `3 * node + component`. A *dof map* sends a model dof
@@ -18,10 +19,12 @@
 pub mod assemble;
 pub mod cholesky;
 pub mod eigen;
+pub mod krylov;
 
 pub use assemble::{add_entries, dof_map, from_columns, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
 pub use cholesky::{lu_solve_in_place, SparseCholesky};
 pub use eigen::{lowest_modes, Modes, ModesOptions};
+pub use krylov::{gmres_into, GmresInfo, GmresOptions};
 
 /// Failures of the sparse linear algebra, each with what to change.
 #[derive(Debug, thiserror::Error)]

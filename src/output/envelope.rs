@@ -53,6 +53,36 @@ pub struct FaceEnvelope {
     /// it was added.
     #[serde(default)]
     pub corners: Vec<Vec<[f64; 3]>>,
+    /// Per face: its area [m²] (tri3: half the cross product of two edges; quad4: half the
+    /// cross product of its diagonals, exact for a plane quad). Empty in files written before
+    /// it was added.
+    #[serde(default)]
+    pub areas: Vec<f64>,
+}
+
+/// Tension thresholds of the demand–capacity area measure [Pa]: 3, 5 and 10 MPa. Why: the
+/// face area above a tensile stress, as USACE EM 1110-2-6053 plots it against the concrete's
+/// dynamic tensile strength (3–5 MPa for dam concrete; 10 MPa well above any strength, the
+/// area where a linear model is far from a cracked dam).
+pub const TENSION_THRESHOLDS: [f64; 3] = [3e6, 5e6, 10e6];
+
+impl FaceEnvelope {
+    /// The area [m²] of the faces whose largest σ1 over the run exceeded `threshold` [Pa]
+    /// (0 when the file has no areas).
+    pub fn area_above(&self, threshold: f64) -> f64 {
+        self.areas.iter().zip(&self.max_principal).filter(|(_, s)| **s > threshold).map(|(a, _)| a).sum()
+    }
+}
+
+/// Area of a tri3 or quad4 face with corner points `x` (see [`FaceEnvelope::areas`]).
+fn face_area(x: &[[f64; 3]]) -> f64 {
+    let v = |p: [f64; 3]| nalgebra::Vector3::from(p);
+    let cross = match x.len() {
+        3 => (v(x[1]) - v(x[0])).cross(&(v(x[2]) - v(x[0]))),
+        4 => (v(x[2]) - v(x[0])).cross(&(v(x[3]) - v(x[1]))),
+        _ => return 0.0,
+    };
+    0.5 * cross.norm()
 }
 
 /// What `envelope.json` holds.
@@ -259,6 +289,7 @@ impl EnvelopeWriter {
                                 .collect()
                         })
                         .collect(),
+                    areas: fs.iter().map(|&(c, _)| face_area(&mesh.cells[c].nodes().iter().map(|&n| mesh.nodes[n as usize]).collect::<Vec<_>>())).collect(),
                 }
             })
             .collect();
@@ -313,5 +344,35 @@ impl EnvelopeWriter {
         )
         .map_err(|e| OutputError::write(&p, e))?;
         Ok(Some(p))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_areas_sum_to_the_face_and_the_area_above_a_threshold_counts_only_those_faces() {
+        // Reference: the x0 face of a 2 × 1 × 1 m box is 1 m² whatever its cells (quad4 of a
+        // hex mesh, tri3 of a tet mesh); to 1e-12. Then a hand-made envelope: faces of 1, 2
+        // and 3 m² at 2, 4 and 11 MPa: above 3 MPa 5 m², above 5 MPa 3 m², above 10 MPa 3 m².
+        for tets in [false, true] {
+            let m = crate::linalg::assemble::tests::box_model(tets, [2, 3, 2]);
+            let w = EnvelopeWriter::create(&m, &EnvelopeSpec { faces: vec!["b:x0".into()], stride: 1 }).unwrap();
+            let env = w.envelope(&m);
+            let total: f64 = env.faces[0].areas.iter().sum();
+            assert!((total - 1.0).abs() < 1e-12, "tets {tets}: {total}");
+        }
+        let f = FaceEnvelope {
+            group: "g".into(),
+            elements: vec![0, 1, 2],
+            max_principal: vec![2e6, 4e6, 11e6],
+            min_principal: vec![0.0; 3],
+            max_tension: Extreme::default(),
+            max_compression: Extreme::default(),
+            areas: vec![1.0, 2.0, 3.0],
+        };
+        let got: Vec<f64> = TENSION_THRESHOLDS.iter().map(|&t| f.area_above(t)).collect();
+        assert_eq!(got, vec![5.0, 3.0, 3.0]);
     }
 }

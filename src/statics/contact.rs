@@ -7,7 +7,13 @@
 //! iterations). Each pair of a joint that is not tied carries a force q(w) that is a continuous,
 //! piecewise-linear function of its relative motion w; the out-of-balance force of the model
 //! with these forces is driven to zero by u ← u + K_T⁻¹ R(u), with K_T the stiffness plus each
-//! pair's tangent (sparse Cholesky on the model with the tied joints eliminated, `bonded`).
+//! pair's tangent, on the model with the tied joints eliminated (`bonded`). Each direction
+//! K_T⁻¹ R is solved by GMRES preconditioned by the sparse Cholesky factorisation of K_T
+//! without the friction coupling (symmetric positive definite), analysed once and factorised
+//! again only when pairs change state ([`TangentSolver`]); a sparse LU of the assembled K_T is
+//! the fallback when GMRES does not converge. The LU on every iteration, as first written, took
+//! 1243 s and 11 GB on the fine dam mesh (faer's LU orders the columns by COLAMD and bounds
+//! the fill by the pattern of AᵀA: docs/performance.md, "Static state").
 //!
 //! Conventions (written once, here): w = Σ_I N_I Δu_I − Δu_s is the master point's motion
 //! relative to the slave node over the increment, with N_I the weights of the pair's master
@@ -20,7 +26,7 @@
 //! - **stick** (k |w_t| ≤ L, L = `JointLaw::shear_limit`(r_n)): q = k w, tangent k I;
 //! - **slip**: q = k g n + L w_t/|w_t|, tangent k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) − μ k t̂ nᵀ,
 //!   t̂ = w_t/|w_t|. The last term (the limit grows with the normal force) makes K_T
-//!   unsymmetric, so the solves are sparse LU; without it Newton diverged on the coarse dam
+//!   unsymmetric (hence GMRES, not CG); without it Newton diverged on the coarse dam
 //!   (it is of the penalty's size).
 //!
 //! This friction law is holonomic (deformation theory): the increment is one proportional
@@ -41,7 +47,7 @@ use crate::contact::joint::{ContactJoint, Method};
 use crate::contact::law::{PairHistory, PairState};
 use crate::contact::ContactState;
 use crate::error::{Error, ModelError};
-use crate::linalg::{add_entries, lu_solve_in_place, stiffness};
+use crate::linalg::{add_entries, gmres_into, lu_solve_in_place, stiffness, Csc, GmresOptions, SparseCholesky};
 use crate::problem::Problem;
 use nalgebra::{Matrix3, Vector3};
 
@@ -100,14 +106,19 @@ pub struct StaticContactInfo {
     /// Largest tension of a closed pair beyond its tensile strength (only held pairs can have
     /// one), relative to the largest normal force.
     pub condition_violation: f64,
+    /// How the Newton directions were solved (GMRES on the preconditioner's factorisations).
+    pub solver: DirectionStats,
 }
 
 impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations, residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations ({} factorisations, {} GMRES products{}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
+            self.solver.factorisations,
+            self.solver.krylov_products,
+            if self.solver.lu_fallbacks > 0 { format!(", {} LU solves", self.solver.lu_fallbacks) } else { String::new() },
             self.residual,
             if self.converged { "" } else { " (NOT converged)" },
             self.stick,
@@ -140,25 +151,210 @@ fn relative_motion(p: &Pair, uh: &[f64]) -> Vector3<f64> {
     Vector3::from_fn(|c, _| p.w[c].iter().map(|&(r, v)| v * uh[r]).sum())
 }
 
+/// A pair's tangent ∂q/∂w split as `spd + coupling`: `spd` symmetric positive semi-definite
+/// (k I stick; k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) slip; 0 open), `coupling` the friction
+/// limit's growth with the normal force (−μ k t̂ nᵀ while slipping, else 0), and the state.
+#[derive(Clone, Copy, Debug)]
+struct PairTangent {
+    state: PairState,
+    spd: Matrix3<f64>,
+    coupling: Matrix3<f64>,
+}
+
 /// The law of the module header at w: state, force q on the slave, tangent ∂q/∂w.
-fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, hold_closed: bool) -> (PairState, Vector3<f64>, Matrix3<f64>) {
+fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, hold_closed: bool) -> (PairState, Vector3<f64>, PairTangent) {
     let history = PairHistory::default();
     let g = p.n.dot(w);
     let r_n = -p.k * g;
     if r_n < -law.tensile_strength * p.area && !hold_closed {
-        return (PairState::Open, Vector3::zeros(), Matrix3::zeros());
+        return (PairState::Open, Vector3::zeros(), PairTangent { state: PairState::Open, spd: Matrix3::zeros(), coupling: Matrix3::zeros() });
     }
     let wt = w - p.n * g;
     let limit = law.shear_limit(r_n, &history, p.area);
     let nn = p.n * p.n.transpose();
     if p.k * wt.norm() <= limit {
-        (PairState::Stick, w * p.k, Matrix3::identity() * p.k)
+        (PairState::Stick, w * p.k, PairTangent { state: PairState::Stick, spd: Matrix3::identity() * p.k, coupling: Matrix3::zeros() })
     } else {
         let t = wt / wt.norm();
         let ks = limit / wt.norm();
         // ∂L/∂w = −μ k nᵀ while the limit is above its floor 0
         let coupling = if limit > 0.0 { t * p.n.transpose() * (-law.mu * p.k) } else { Matrix3::zeros() };
-        (PairState::Slip, p.n * (p.k * g) + t * limit, nn * p.k + (Matrix3::identity() - nn - t * t.transpose()) * ks + coupling)
+        let spd = nn * p.k + (Matrix3::identity() - nn - t * t.transpose()) * ks;
+        (PairState::Slip, p.n * (p.k * g) + t * limit, PairTangent { state: PairState::Slip, spd, coupling })
+    }
+}
+
+/// Relative tolerance of each Newton direction's GMRES solve, ‖K_T d − R‖ ≤ this × ‖R‖
+/// (dimensionless): 1e-9. Why: Newton then converges as with an exact solve down to
+/// [`TOLERANCE`] (an inexact Newton step with a forcing term this small keeps the quadratic
+/// convergence far below the 1e-8 asked), and it costs a few more products than 1e-6.
+pub const DIRECTION_TOLERANCE: f64 = 1e-9;
+
+/// How the Newton directions were solved: factorisations of the preconditioner, GMRES
+/// products, direct LU solves (the fallback), and the seconds each took.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct DirectionStats {
+    pub factorisations: usize,
+    pub krylov_products: usize,
+    pub lu_fallbacks: usize,
+    /// Entries of the preconditioner's Cholesky factor (8 B each).
+    pub factor_entries: usize,
+    pub factor_seconds: f64,
+    pub krylov_seconds: f64,
+}
+
+/// The Newton direction d = K_T⁻¹ R with K_T = K̂ + Σ_p B_pᵀ (S_p + C_p) B_p (the pair tangents
+/// of [`PairTangent`], applied pair by pair, never assembled): GMRES
+/// (`linalg::krylov::gmres_into`) preconditioned by the sparse Cholesky factorisation of the
+/// symmetric positive definite P = K̂ + Σ_p B_pᵀ S_p B_p. P's pattern (K̂ and every pair's block,
+/// open or not) is analysed once (AMD ordering); P is factorised again only when a pair changed
+/// its state since the last factorisation or GMRES needed more than [`REFACTOR_PRODUCTS`]
+/// products, so iterations that only move the slipping pairs reuse it. K_T − P is the friction
+/// couplings C_p (one rank-one term per slipping pair) and the slipping pairs' changed
+/// stiffness since the factorisation.
+struct TangentSolver {
+    p: Csc,
+    /// Per entry of K̂, its position in `p.val`.
+    k0_pos: Vec<usize>,
+    /// Per pair-block entry (pair, c, d, entry a of w_c, entry b of w_d, in that order), its
+    /// position in `p.val`.
+    pair_pos: Vec<usize>,
+    chol: Option<SparseCholesky>,
+    /// The states the factorisation was made with.
+    factored_states: Vec<PairState>,
+    stale_products: bool,
+    stats: DirectionStats,
+    y: Vec<f64>,
+}
+
+/// GMRES products above which the next direction refactorises the preconditioner: 40. Why: a
+/// fresh factorisation needs a handful; many more mean the slipping pairs have moved far
+/// from the stiffness it was made with.
+pub const REFACTOR_PRODUCTS: usize = 40;
+
+impl TangentSolver {
+    fn new(k0: &Csc, pairs: &[Pair]) -> TangentSolver {
+        let mut entries = Vec::new();
+        for p in pairs {
+            for wc in &p.w {
+                for wd in &p.w {
+                    for &(a, _) in wc {
+                        for &(b, _) in wd {
+                            entries.push((a, b, 0.0));
+                        }
+                    }
+                }
+            }
+        }
+        let p = add_entries(k0, &entries);
+        let pos = |i: usize, j: usize| p.col_ptr[j] + p.row[p.col_ptr[j]..p.col_ptr[j + 1]].binary_search(&i).expect("P's pattern holds K̂ and the pair blocks");
+        let mut k0_pos = Vec::with_capacity(k0.nnz());
+        for j in 0..k0.n_cols {
+            for q in k0.col_ptr[j]..k0.col_ptr[j + 1] {
+                k0_pos.push(pos(k0.row[q], j));
+            }
+        }
+        let pair_pos = entries.iter().map(|&(a, b, _)| pos(a, b)).collect();
+        let n = k0.n_rows;
+        TangentSolver { p, k0_pos, pair_pos, chol: None, factored_states: Vec::new(), stale_products: false, stats: DirectionStats::default(), y: vec![0.0; n] }
+    }
+
+    /// P's values for the tangents `tangents`, then its numeric factorisation.
+    fn factorise(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent]) -> Result<(), Error> {
+        let start = std::time::Instant::now();
+        self.p.val.fill(0.0);
+        for (q, &v) in self.k0_pos.iter().zip(&k0.val) {
+            self.p.val[*q] += v;
+        }
+        let mut e = 0;
+        for (p, tg) in pairs.iter().zip(tangents) {
+            for (c, wc) in p.w.iter().enumerate() {
+                for (d, wd) in p.w.iter().enumerate() {
+                    let s = tg.spd[(c, d)];
+                    for &(_, va) in wc {
+                        for &(_, vb) in wd {
+                            self.p.val[self.pair_pos[e]] += s * va * vb;
+                            e += 1;
+                        }
+                    }
+                }
+            }
+        }
+        let what = "static stage with the joints active: the Newton preconditioner K + the pairs' stiffness";
+        match self.chol.as_mut() {
+            Some(ch) => ch.refactor(&self.p, what),
+            None => SparseCholesky::factor(&self.p, what, faer::Par::Seq).map(|ch| self.chol = Some(ch)),
+        }
+        .map_err(|e| ModelError::Invalid(e.to_string()))?;
+        self.factored_states = tangents.iter().map(|t| t.state).collect();
+        self.stale_products = false;
+        self.stats.factorisations += 1;
+        self.stats.factor_entries = self.chol.as_ref().map_or(0, |c| c.factor_entries());
+        self.stats.factor_seconds += start.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// r ← K_T⁻¹ r.
+    fn direction_in_place(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent], r: &mut [f64]) -> Result<(), Error> {
+        let changed = self.chol.is_none() || self.stale_products || self.factored_states.iter().zip(tangents).any(|(s, t)| *s != t.state);
+        if changed {
+            self.factorise(k0, pairs, tangents)?;
+        }
+        let opts = GmresOptions { tolerance: DIRECTION_TOLERANCE, ..Default::default() };
+        for attempt in 0..2 {
+            let start = std::time::Instant::now();
+            let chol = self.chol.as_mut().expect("factorised above");
+            self.y.fill(0.0);
+            let apply = |x: &[f64], out: &mut [f64]| {
+                k0.mul_into(x, out);
+                for (p, tg) in pairs.iter().zip(tangents) {
+                    if tg.state == PairState::Open {
+                        continue;
+                    }
+                    let w = relative_motion(p, x);
+                    let q = (tg.spd + tg.coupling) * w;
+                    for (c, wc) in p.w.iter().enumerate() {
+                        for &(a, va) in wc {
+                            out[a] += q[c] * va;
+                        }
+                    }
+                }
+            };
+            let g = gmres_into(apply, |v| chol.solve_in_place(v), r, &mut self.y, &opts);
+            self.stats.krylov_products += g.iterations;
+            self.stats.krylov_seconds += start.elapsed().as_secs_f64();
+            if g.converged {
+                self.stale_products = g.iterations > REFACTOR_PRODUCTS;
+                r.copy_from_slice(&self.y);
+                return Ok(());
+            }
+            if attempt == 0 && !changed {
+                // a stale preconditioner: factorise at this state and try again
+                self.factorise(k0, pairs, tangents)?;
+                continue;
+            }
+            break;
+        }
+        // the fallback: the assembled tangent, sparse LU
+        self.stats.lu_fallbacks += 1;
+        let mut extra = Vec::new();
+        for (p, tg) in pairs.iter().zip(tangents) {
+            let t = tg.spd + tg.coupling;
+            for (c, wc) in p.w.iter().enumerate() {
+                for (d, wd) in p.w.iter().enumerate() {
+                    if t[(c, d)] == 0.0 {
+                        continue;
+                    }
+                    for &(a, va) in wc {
+                        for &(b, vb) in wd {
+                            extra.push((a, b, t[(c, d)] * va * vb));
+                        }
+                    }
+                }
+            }
+        }
+        lu_solve_in_place(&add_entries(k0, &extra), r, "static stage with the joints active").map_err(|e| ModelError::Invalid(e.to_string()))?;
+        Ok(())
     }
 }
 
@@ -221,15 +417,18 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
     let nf = norm(&f0);
     let mut uh = vec![0.0; t.n];
-    // R(u) = F − K u − Σ Bᵀ q into `r`, the contact part of the tangent into `extra` when asked,
-    // and each pair's closed flag
-    let evaluate = |uh: &[f64], pairs: &[Pair], r: &mut Vec<f64>, extra: Option<&mut Vec<(usize, usize, f64)>>, closed: &mut Vec<bool>| {
+    // R(u) = F − K u − Σ Bᵀ q into `r`, each pair's state and tangent into `tangents` when
+    // asked, and each pair's closed flag
+    let evaluate = |uh: &[f64], pairs: &[Pair], r: &mut Vec<f64>, tangents: Option<&mut Vec<PairTangent>>, closed: &mut Vec<bool>| {
         k0.mul_into(uh, r);
         for (ri, fi) in r.iter_mut().zip(&f0) {
             *ri = fi - *ri;
         }
         closed.clear();
-        let mut extra = extra;
+        let mut tangents = tangents;
+        if let Some(t) = tangents.as_deref_mut() {
+            t.clear();
+        }
         for p in pairs {
             let w = relative_motion(p, uh);
             let (state, q, tangent) = pair_force(p, &w, &problem.joints[p.joint].law, p.changes >= CHATTER_CHANGES);
@@ -238,30 +437,20 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
                 for &(a, va) in wc {
                     r[a] -= q[c] * va;
                 }
-                if let Some(extra) = extra.as_deref_mut() {
-                    for (d, wd) in p.w.iter().enumerate() {
-                        let kcd = tangent[(c, d)];
-                        if kcd == 0.0 {
-                            continue;
-                        }
-                        for &(a, va) in wc {
-                            for &(b, vb) in wd {
-                                extra.push((a, b, kcd * va * vb));
-                            }
-                        }
-                    }
-                }
+            }
+            if let Some(t) = tangents.as_deref_mut() {
+                t.push(tangent);
             }
         }
         if nf > 0.0 { norm(r) / nf } else { 0.0 }
     };
     let (mut r, mut r_try) = (vec![0.0; t.n], vec![0.0; t.n]);
     let (mut closed, mut closed_try) = (Vec::new(), Vec::new());
-    let mut extra = Vec::new();
+    let mut tangents = Vec::with_capacity(pairs.len());
     let mut u_try = vec![0.0; t.n];
+    let mut solver = TangentSolver::new(&k0, &pairs);
     for it in 0..=MAX_ITERATIONS {
-        extra.clear();
-        info.residual = evaluate(&uh, &pairs, &mut r, Some(&mut extra), &mut closed);
+        info.residual = evaluate(&uh, &pairs, &mut r, Some(&mut tangents), &mut closed);
         info.iterations = it;
         for (p, &c) in pairs.iter_mut().zip(&closed) {
             if c != p.closed {
@@ -273,8 +462,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
             info.converged = info.residual < TOLERANCE;
             break;
         }
-        let kt = add_entries(&k0, &extra);
-        lu_solve_in_place(&kt, &mut r, "static stage with the joints active").map_err(|e| ModelError::Invalid(e.to_string()))?;
+        solver.direction_in_place(&k0, &pairs, &tangents, &mut r)?;
         // backtracking line search on ‖R‖ (Armijo, halving): the law is only piecewise smooth
         let mut step = 1.0;
         for _ in 0..LINE_SEARCH_HALVINGS {
@@ -289,6 +477,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
         }
         uh.copy_from_slice(&u_try);
     }
+    info.solver = solver.stats;
     // the result and the pairs' records
     let mut du = vec![0.0; t.n_dofs];
     t.expand_into(&uh, &mut du);

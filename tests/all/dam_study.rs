@@ -134,8 +134,16 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
             o.iter().chain(&s).all(|&v| v.is_finite() && v >= 0.0),
             "opening and slip ≥ 0: {x}"
         );
-        // the joint envelopes (per-joint histories of the largest opening and slip) are written
+        // "slip" is the largest NET tangential displacement |d_t| (design §7), the path
+        // Σ|Δd_t| its second column, never smaller (regression: the report's slip was the path)
+        let path = vec(x, "slip_path");
+        assert!(s.iter().zip(&path).all(|(n, p)| n <= p), "net ≤ path: {s:?} {path:?}");
+        let res = jointquake::study::StudyResults::read(&study).unwrap();
         let id = x["id"].as_str().unwrap();
+        let h = res.run(id).unwrap().joint_history("J01").unwrap();
+        let top = |c: &str| h.column(c).unwrap().iter().copied().fold(0.0f64, f64::max);
+        assert_eq!((s[0], path[0]), (top("max_tangential_displacement"), top("max_slip")), "{id}: J01");
+        // the joint envelopes (per-joint histories of the largest opening and slip) are written
         for j in 1..=28 {
             assert!(
                 dir.join(format!("out/runs/{id}/histories/joint_J{j:02}.csv"))

@@ -8,8 +8,9 @@
 //! What it reads from a run: its level (the run's PGA over `design_pga`), its mesh label
 //! (`mesh_axis`), its method from its scene's contraction-joint entry (`joints`: tied → the
 //! monolithic dam; `ntn` → NTN; `nts` with `layer` 2 → NTS-Layer2, else NTS), per joint the
-//! largest opening and accumulated slip over the record (`histories/joint_<J>.csv`, columns
-//! `max_opening`, `max_slip`: also for a run that stopped, up to where it stopped), the search
+//! largest opening, net slip and slip path over the record (`histories/joint_<J>.csv`, columns
+//! `max_opening`, `max_tangential_displacement` = the net slip |d_t| the report calls "slip",
+//! `max_slip` = the path Σ|Δd_t|: also for a run that stopped, up to where it stopped), the search
 //! and Gauss–Seidel diagnostics per joint (`summary.json`), the face stress envelopes
 //! (`envelope.json`, [`crate::output::envelope`]) and the crest monitors' histories.
 //!
@@ -18,6 +19,7 @@
 //! tension positive; crest radial displacement positive downstream, along the horizontal
 //! normal of the upstream crest arch y = x² / (2 Rc) at the monitor, (−x/Rc, 1, 0) normalised.
 
+pub mod convergence;
 pub mod face_maps;
 pub mod report;
 pub mod static_table;
@@ -210,9 +212,12 @@ pub struct DamRun {
     /// Record time reached [s] (last joint-history row).
     pub t_end: f64,
     pub joints: Vec<String>,
-    /// Per joint: largest opening and accumulated slip over the record [m].
+    /// Per joint: largest opening and largest net slip |d_t| over the record [m] (design §7:
+    /// slip is the net tangential displacement, as the seed's "maximum tangential slip").
     pub opening: Vec<f64>,
     pub slip: Vec<f64>,
+    /// Per joint: largest slip path Σ|Δd_t| over the record [m] (the second slip column).
+    pub slip_path: Vec<f64>,
     /// Per joint (finished runs).
     pub diagnostics: Option<Vec<JointDiagnostics>>,
     /// From `envelope.json` (finished runs that asked for it).
@@ -231,6 +236,9 @@ impl DamRun {
     }
     pub fn max_slip(&self) -> (usize, f64) {
         argmax(&self.slip)
+    }
+    pub fn max_slip_path(&self) -> (usize, f64) {
+        argmax(&self.slip_path)
     }
     pub fn is_main(&self, p: &DamParams) -> bool {
         self.mesh == p.main_mesh
@@ -376,19 +384,21 @@ impl DamKind {
             .unwrap_or(&p.main_mesh)
             .to_string();
         let joints = self.joint_names(r)?;
-        let (mut opening, mut slip) = (Vec::new(), Vec::new());
+        let (mut opening, mut slip, mut slip_path) = (Vec::new(), Vec::new(), Vec::new());
         let mut t_end = 0.0f64;
         let mut worst: Option<(f64, Vec<(f64, f64)>)> = None;
         for j in &joints {
             let h = r.joint_history(j)?;
-            let (t, o, s) = (
+            let (t, o, s, net) = (
                 h.column("t")?,
                 h.column("max_opening")?,
                 h.column("max_slip")?,
+                h.column("max_tangential_displacement")?,
             );
             let mo = o.iter().copied().fold(0.0f64, f64::max);
             opening.push(mo);
-            slip.push(s.iter().copied().fold(0.0f64, f64::max));
+            slip.push(net.iter().copied().fold(0.0f64, f64::max));
+            slip_path.push(s.iter().copied().fold(0.0f64, f64::max));
             t_end = t_end.max(t.last().copied().unwrap_or(0.0));
             if worst.as_ref().is_none_or(|w| mo > w.0) {
                 worst = Some((mo, t.iter().copied().zip(o.iter().copied()).collect()));
@@ -446,6 +456,7 @@ impl DamKind {
             joints,
             opening,
             slip,
+            slip_path,
             diagnostics,
             stress,
             crest,
