@@ -15,6 +15,8 @@
 //! half is later and smaller. The stress (z up, depth d = z_s − z) is
 //! τ = M (1 + iωβ) ∂U/∂z = M (1 + iωβ) k* sin(k*d) U_s.
 //!
+//! Band: the record is low-passed at [`ColumnSpec::f_max`] (see there why).
+//!
 //! Time base: the series are delayed by [`ColumnField::delay`] (the travel time from the base
 //! to the surface, whole samples) so the incident wave at the base starts after t = 0: the
 //! surface record plays at t − delay. The record is padded with zeros in front (the delay) and
@@ -39,6 +41,12 @@ pub struct ColumnSpec {
     pub alpha: f64,
     /// Stiffness-proportional damping β [s].
     pub beta: f64,
+    /// Highest frequency carried [Hz]: the field is the record low-passed there (a cosine
+    /// taper from 0.8 f_max to f_max). Deconvolving through a damped column multiplies a
+    /// frequency by |e^{ik*H}|, which grows exponentially with frequency under β (the record's
+    /// noise near its Nyquist frequency would come back amplified by e^{10} and more), and a
+    /// finite-element rock carries no more than its mesh resolves anyway.
+    pub f_max: f64,
 }
 
 impl ColumnSpec {
@@ -55,6 +63,19 @@ impl ColumnSpec {
         if k.re < 0.0 { -k } else { k }
     }
 
+    /// The low-pass weight of angular frequency ω (1 below 0.8 f_max, 0 above f_max).
+    pub fn pass(&self, omega: f64) -> f64 {
+        let f = omega / (2.0 * std::f64::consts::PI);
+        let lo = 0.8 * self.f_max;
+        if f <= lo {
+            1.0
+        } else if f >= self.f_max {
+            0.0
+        } else {
+            0.5 * (1.0 + (std::f64::consts::PI * (f - lo) / (self.f_max - lo)).cos())
+        }
+    }
+
     /// Complex modulus M (1 + iωβ) [Pa].
     fn complex_modulus(&self, omega: f64) -> Complex<f64> {
         Complex::new(self.modulus, self.modulus * omega * self.beta)
@@ -64,6 +85,7 @@ impl ColumnSpec {
 /// What the column gives at one depth: series sampled at `dt` from t = 0.
 #[derive(Clone, Debug, Default)]
 pub struct DepthSeries {
+    /// Acceleration [m/s²] (at the surface only; empty below).
     pub accel: Vec<f64>,
     pub vel: Vec<f64>,
     pub disp: Vec<f64>,
@@ -141,11 +163,24 @@ pub fn incident_at_base(spec: &ColumnSpec, surface: &[f64], dt: f64) -> (Vec<f64
     let travel = delay_samples(spec.height, spec.speed(), dt);
     let (mut half, n) = surface_spectrum(surface, travel, travel);
     for (k, z) in half.iter_mut().enumerate() {
-        let kk = spec.wavenumber(omega_of(k, n, dt));
-        *z *= 0.5 * (Complex::new(0.0, 1.0) * kk * spec.height).exp();
+        let w = omega_of(k, n, dt);
+        let kk = spec.wavenumber(w);
+        *z *= 0.5 * spec.pass(w) * (Complex::new(0.0, 1.0) * kk * spec.height).exp();
     }
     let mut planner = FftPlannerScalar::new();
     (inverse_real(&half, n, &mut planner), travel as f64 * dt)
+}
+
+/// The record `a` [at `dt`] low-passed as `spec` says ([`ColumnSpec::pass`]), same length: the
+/// surface motion the field reproduces.
+pub fn low_pass(spec: &ColumnSpec, a: &[f64], dt: f64) -> Vec<f64> {
+    let (mut half, n) = surface_spectrum(a, 0, 0);
+    for (k, z) in half.iter_mut().enumerate() {
+        *z *= spec.pass(omega_of(k, n, dt));
+    }
+    let mut out = inverse_real(&half, n, &mut FftPlannerScalar::new());
+    out.truncate(a.len());
+    out
 }
 
 /// The free field of `spec` under the surface record `surface` [m/s², at `dt`] at `levels`
@@ -164,8 +199,9 @@ pub fn free_field(spec: &ColumnSpec, surface: &[f64], dt: f64, levels: usize) ->
             for (k, z) in half.iter().enumerate() {
                 let w = omega_of(k, n, dt);
                 let kk = spec.wavenumber(w);
-                a.push(*z * (kk * d).cos());
-                s.push(*z * spec.complex_modulus(w) * kk * (kk * d).sin());
+                let z = *z * spec.pass(w);
+                a.push(z * (kk * d).cos());
+                s.push(z * spec.complex_modulus(w) * kk * (kk * d).sin());
             }
             let accel = inverse_real(&a, n, &mut planner);
             // the stress's second time derivative, integrated twice from rest
@@ -173,6 +209,8 @@ pub fn free_field(spec: &ColumnSpec, surface: &[f64], dt: f64, levels: usize) ->
             let vel = integrate_from_rest(&accel, dt);
             let disp = integrate_from_rest(&vel, dt);
             let stress = integrate_from_rest(&integrate_from_rest(&stress_dd, dt), dt);
+            // the acceleration is kept at the surface only (the input, for checks)
+            let accel = if d == 0.0 { accel } else { Vec::new() };
             DepthSeries { accel, vel, disp, stress }
         })
         .collect();
@@ -209,7 +247,7 @@ impl ColumnField {
     /// The field at depth weights `dw` and time `t` [s], linear in depth and time; the last
     /// sample held after the end, rest before t = 0.
     pub fn at(&self, dw: DepthWeight, t: f64) -> FieldValue {
-        let n = self.series[0].accel.len();
+        let n = self.series[0].vel.len();
         let s = (t / self.dt).max(0.0);
         let (i, f) = if s >= (n - 1) as f64 { (n - 2, 1.0) } else { (s.floor() as usize, s - s.floor()) };
         let pick = |x: &DepthSeries| -> [f64; 3] {

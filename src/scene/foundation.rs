@@ -64,6 +64,10 @@ pub struct FoundationScene {
     /// rock (the highest rock node; the canyon is ignored in the free field).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface: Option<f64>,
+    /// Highest frequency of the free field [Hz]: the records are low-passed there before the
+    /// deconvolution. Default 25 (`problem::foundation::free_field::DEFAULT_MAX_FREQUENCY`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_frequency: Option<f64>,
     /// Whether the massed rock carries its weight. Default false: the rock's in-situ state
     /// predates the dam (as with the massless rock), so the static state is the same in every
     /// model and only the dam's loads strain the rock.
@@ -77,7 +81,7 @@ fn default_far() -> Vec<String> {
 
 impl Default for FoundationScene {
     fn default() -> Self {
-        FoundationScene { model: FoundationModel::Massless, rock: None, far: default_far(), springs: false, spring_distance: None, surface: None, rock_weight: false }
+        FoundationScene { model: FoundationModel::Massless, rock: None, far: default_far(), springs: false, spring_distance: None, surface: None, max_frequency: None, rock_weight: false }
     }
 }
 
@@ -113,6 +117,12 @@ impl FoundationScene {
         radiating_only(self.springs, "springs")?;
         radiating_only(self.spring_distance.is_some(), "spring_distance")?;
         radiating_only(self.surface.is_some(), "surface")?;
+        radiating_only(self.max_frequency.is_some(), "max_frequency")?;
+        if let Some(f) = self.max_frequency {
+            if !(f > 0.0 && f.is_finite()) {
+                return Err(format!("foundation.max_frequency = {f}: must be a frequency > 0 [Hz]"));
+            }
+        }
         if self.far.is_empty() {
             return Err("foundation.far: give at least one far-boundary face group (default [\"bc:far*\"])".into());
         }

@@ -21,10 +21,13 @@ use crate::model::Model;
 use crate::scene::foundation::{FoundationModel, FoundationScene};
 use crate::scene::Scene;
 
-/// The scene as the model is built: with a massed foundation, the rock's materials massed.
+/// The scene as the model is built: with a massed foundation, the rock's materials massed (and
+/// `foundation.rock` set to them).
 pub fn scene_for_model(mut scene: Scene) -> Scene {
-    let Some(f) = scene.foundation.clone().filter(|f| f.model.massed()) else { return scene };
+    let Some(f) = scene.foundation.as_mut().filter(|f| f.model.massed()) else { return scene };
     let rock: Vec<String> = f.rock_materials(&scene.materials).iter().map(|m| m.group.clone()).collect();
+    // the rock named explicitly: its materials are no longer marked massless
+    f.rock = Some(rock.clone());
     for m in scene.materials.iter_mut().filter(|m| rock.contains(&m.group)) {
         m.massless = false;
     }
@@ -126,7 +129,8 @@ fn far_boundary(scene: &Scene, f: &FoundationScene, model: &Model, rock: &Rock<'
     }
     let alpha = if rock.nodes.first().is_some_and(|&n| model.mass_damped[n]) { model.alpha } else { 0.0 };
     let base = std::mem::take(&mut loads.base);
-    let ff = FreeField::build(&base, rock.material, surface, height, alpha, model.beta);
+    let f_max = f.max_frequency.unwrap_or(super::free_field::DEFAULT_MAX_FREQUENCY);
+    let ff = FreeField::build(&base, rock.material, surface, height, alpha, model.beta, f_max);
     // components the far groups' boundary entries hold (and no other entry does)
     let mut far_bits = vec![0u8; model.n_nodes()];
     let mut other_bits = vec![0u8; model.n_nodes()];
@@ -153,7 +157,7 @@ fn far_boundary(scene: &Scene, f: &FoundationScene, model: &Model, rock: &Rock<'
     };
     let far = FarBoundary::build(&faces, ff, &released)?;
     notes.push(format!(
-        "foundation radiating: {} far faces ({} m², groups {}), {} nodes with Lysmer dashpots{}; free field from {} base record(s) as the surface motion at z = {surface} m, deconvolved through a {height:.1} m uniform column (vertical S for x, y; P for z; Rayleigh α {alpha:.4} 1/s, β {:.3e} s as the rock); the surface record plays at t − {:.3} s",
+        "foundation radiating: {} far faces ({} m², groups {}), {} nodes with Lysmer dashpots{}; free field from {} base record(s) as the surface motion at z = {surface} m, low-passed at {f_max} Hz and deconvolved through a {height:.1} m uniform column (vertical S for x, y; P for z; Rayleigh α {alpha:.4} 1/s, β {:.3e} s as the rock); the surface record plays at t − {:.3} s",
         far.faces,
         far.area,
         groups.join(", "),
