@@ -62,4 +62,10 @@ pub trait Constraint<H: ?Sized> {
     /// f += the internal force of what this constraint stands for, at the displacements `u`
     /// (only called when [`Constraint::replaces_massless_elements`]). Default: nothing.
     fn add_internal_force_into(&mut self, _u: &[f64], _f: &mut [f64]) {}
+
+    /// f += the inertia-free loads this constraint applies at t[n] (`step.t_next` − dt), before
+    /// the prediction: called every step, `dynamic` false during gravity relaxation. The step
+    /// counts them as external work. Default: nothing (e.g. the radiating foundation's held
+    /// reactions, free-field forces and springs, `problem::foundation::radiating`).
+    fn add_external_force_into(&mut self, _model: &Model, _step: &StepContext<'_>, _dynamic: bool, _f: &mut [f64]) {}
 }

@@ -82,6 +82,8 @@ pub struct Simulation<'p> {
     /// The static condensation of the massless blocks (`None` without them); runs after the
     /// contact correction (solve per step) or in the element loop (Schur complement).
     pub foundation: Option<crate::problem::foundation::Condensation>,
+    /// The radiating foundation's far boundary (`None` for the other foundation models).
+    pub radiating: Option<crate::problem::foundation::radiating::Radiating<'p>>,
     pub state: State,
     /// The outcome of [`Self::equilibrate`] (`None` before it, or without a static state).
     pub equilibrium: Option<EquilibriumInfo>,
@@ -118,12 +120,18 @@ impl<'p> Simulation<'p> {
                 i.condensed_unknowns, i.interface_unknowns, i.factor_entries, i.setup_time, i.omega2_bound
             ));
         }
-        let time = TimeStep::resolve(model, &problem.scene.time, penalty + found_w2)?;
+        let mut radiating = problem.far_boundary.as_ref().map(crate::problem::foundation::radiating::Radiating::new);
+        let far_w2 = problem.far_boundary.as_ref().map(|f| f.omega2_bound(model)).unwrap_or(0.0);
+        let time = TimeStep::resolve(model, &problem.scene.time, penalty + found_w2 + far_w2)?;
         notes.extend(time.note());
         let mut solver = ExplicitSolver::new(model, time.dt, problem.scene.time.energy_tolerance);
+        solver.dynamic_held = problem.far_boundary.as_ref().map(|f| f.dynamic_held.clone());
         let mut state = State::at_rest(model, ContactState::new(&problem.joints));
         solver.start_energy(model, &mut state);
-        Ok(Simulation { problem, time, solver, contact, foundation, state, equilibrium: None, notes })
+        if let Some(r) = radiating.as_mut() {
+            r.start(model, &problem.loads, &state.u);
+        }
+        Ok(Simulation { problem, time, solver, contact, foundation, radiating, state, equilibrium: None, notes })
     }
 
     /// The step [s].
@@ -223,6 +231,9 @@ impl<'p> Simulation<'p> {
         if let Some(f) = self.foundation.as_mut() {
             cs.push(f);
         }
+        if let Some(r) = self.radiating.as_mut() {
+            cs.push(r);
+        }
         let eq = relax_gravity(&p.model, &p.loads, &mut self.solver, &mut self.state, &mut cs, tol, max_steps)?;
         self.complete_state()?;
         Ok(eq)
@@ -253,11 +264,25 @@ impl<'p> Simulation<'p> {
         self.state.step = 0;
         self.state.t = 0.0;
         self.solver.start_energy(&self.problem.model, &mut self.state);
+        if let Some(r) = self.radiating.as_mut() {
+            r.start(&self.problem.model, &self.problem.loads, &self.state.u);
+        }
     }
 
     /// One dynamic step (gravity, base motion, loads, Rayleigh damping, contact).
     pub fn step(&mut self) -> Result<StepInfo, StepError> {
         let p = self.problem;
+        if let Some(r) = self.radiating.as_mut() {
+            let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(3);
+            if let Some(c) = self.contact.as_mut() {
+                cs.push(c);
+            }
+            if let Some(f) = self.foundation.as_mut() {
+                cs.push(f);
+            }
+            cs.push(r);
+            return self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut cs);
+        }
         match (self.contact.as_mut(), self.foundation.as_mut()) {
             (Some(c), None) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut [c as &mut dyn Constraint<ContactState>]),
             (None, None) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut []),
@@ -265,6 +290,7 @@ impl<'p> Simulation<'p> {
             (None, Some(f)) => self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut [f as &mut dyn Constraint<ContactState>]),
         }
     }
+
 
     /// u[n−1], u[n], u[n+1] after a step, at t[n] = t − dt (outputs report there, where
     /// central differences give the velocity and acceleration).

@@ -204,6 +204,10 @@ pub struct ExplicitSolver {
     pub energy_stride: usize,
     /// Relative energy-growth limit (from the scene). Default 0.05.
     pub energy_tolerance: f64,
+    /// Components held during the dynamic stage when they differ from [`Model::held`] (a
+    /// radiating foundation's far boundary: held through gravity, free with its dashpots
+    /// after; `problem::foundation::radiating`). `None`: the model's, in every stage.
+    pub dynamic_held: Option<Vec<u8>>,
 }
 
 impl ExplicitSolver {
@@ -221,6 +225,7 @@ impl ExplicitSolver {
             u_nm1: vec![0.0; n],
             energy_stride: 10,
             energy_tolerance,
+            dynamic_held: None,
         }
     }
 
@@ -242,6 +247,16 @@ impl ExplicitSolver {
                 }
                 (a, 0.0)
             }
+        };
+        {
+            let ctx = StepContext { t_next: state.t + dt, dt, u_prev: &state.u_prev, u: &state.u };
+            for c in constraints.iter_mut() {
+                c.add_external_force_into(model, &ctx, dynamic, &mut self.f_ext);
+            }
+        }
+        let held: &[u8] = match (&self.dynamic_held, dynamic) {
+            (Some(h), true) => h,
+            _ => &model.held,
         };
         if beta > 0.0 {
             let c = beta / dt;
@@ -287,7 +302,7 @@ impl ExplicitSolver {
             for (k, unode) in un.chunks_exact_mut(3).enumerate() {
                 let node = first + k;
                 let m = model.mass.inertial[node];
-                let fx = model.held[node];
+                let fx = held[node];
                 for c in 0..3 {
                     let i = 3 * node + c;
                     if fx & (1 << c) != 0 {
@@ -311,7 +326,7 @@ impl ExplicitSolver {
             let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
             for c in 0..3 {
                 let i = i0 + c;
-                self.u_next[i] = if model.held[node] & (1 << c) != 0 {
+                self.u_next[i] = if held[node] & (1 << c) != 0 {
                     0.0
                 } else {
                     let vb = (state.u[i] - state.u_prev[i]) / dt;

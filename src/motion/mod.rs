@@ -19,6 +19,7 @@
 
 pub mod baseline;
 pub mod chart;
+pub mod column;
 pub mod commands;
 pub mod io;
 pub mod measures;

@@ -28,11 +28,14 @@ pub struct Problem {
     pub loads: Loads,
     /// Notes of the build (records read and scaled, snapped loads).
     pub notes: Vec<String>,
+    /// The radiating foundation's far boundary (`None` for the other foundation models).
+    pub far_boundary: Option<foundation::radiating::FarBoundary>,
 }
 
 impl Problem {
     /// Build the model, the joints and the loads of `scene` on `mesh`.
     pub fn build(scene: Scene, mesh: Mesh) -> Result<Problem, Error> {
+        let scene = foundation::massed::scene_for_model(scene);
         let mut model = Model::build(mesh, &scene)?;
         let mut notes = Vec::new();
         if let Some(r) = scene.reservoir.as_ref().filter(|r| r.added_mass) {
@@ -53,7 +56,8 @@ impl Problem {
             let total: f64 = loads.static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
             notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), loads.static_forces.len(), total));
         }
-        Ok(Problem { scene, model, joints, loads, notes })
+        let far_boundary = foundation::massed::prepare_loads(&scene, &model, &mut loads, &mut notes)?;
+        Ok(Problem { scene, model, joints, loads, notes, far_boundary })
     }
 }
 

@@ -4,6 +4,7 @@
 //! errors (`deny_unknown_fields`). Relative paths inside a scene are relative to the scene
 //! file's directory. Units: SI (m, kg, s, Pa, N); record amplitudes are in g.
 
+pub mod foundation;
 pub mod patterns;
 pub mod reservoir;
 
@@ -43,6 +44,9 @@ pub struct Scene {
     /// Reservoir on wet face groups: hydrostatic pressure and added mass (docs/dam_physics.md).
     #[serde(default)]
     pub reservoir: Option<ReservoirScene>,
+    /// The rock model: massless (default, the seed's), massed_fixed or radiating ([`foundation`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub foundation: Option<foundation::FoundationScene>,
 }
 
 /// The reservoir of a dam (incompressible water; module problem::reservoir).
@@ -877,6 +881,7 @@ impl Scene {
                 }
             }
         }
+        self.foundation.as_ref().map_or(Ok(()), |f| f.validate(&self.materials))?;
         if self.loads.base.len() > 3 {
             return Err(format!("loads.base: {} records given, at most 3", self.loads.base.len()));
         }

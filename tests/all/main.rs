@@ -13,6 +13,7 @@ mod contact_validation;
 mod dam_physics;
 mod dam_study;
 mod dynamics;
+mod foundation;
 mod fuzz;
 mod joint_tests;
 mod mesh;

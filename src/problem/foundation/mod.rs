@@ -28,6 +28,10 @@
 //! sum Σ_j |K_ij| / √(m_i m_j) over the interface dofs ([`Condensation::omega2_bound`]), added to
 //! the element bound of the massive elements (λ_max(A + B) ≤ λ_max(A) + λ_max(B)).
 
+pub mod free_field;
+pub mod massed;
+pub mod radiating;
+
 use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
 use crate::linalg::{dof_map, restrict, stiffness_of, Csc, LinalgError, SparseCholesky, NONE};

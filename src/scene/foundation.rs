@@ -1,0 +1,149 @@
+//! The scene's `foundation`: which rock model a run uses (issue 29; docs/scenes.md,
+//! docs/dam_physics.md "Foundation models").
+//!
+//! Absent (or `"model": "massless"`): the seed's configuration, unchanged (the rock material
+//! marked `massless` is condensed statically, the record moves the fixed far boundary
+//! rigidly). `"massed_fixed"`: the rock's materials keep their density (mass, no weight by
+//! default), the far boundary stays fixed and the record is the same rigid base motion: the
+//! reflecting case. `"radiating"`: massed rock, Lysmer dashpots (optionally springs) on the far
+//! boundary faces, and the records taken as the surface free field, deconvolved through a 1-D
+//! column (`crate::motion::column`) and applied as effective forces on the far faces.
+
+use super::MaterialSpec;
+use serde::{Deserialize, Serialize};
+
+/// The rock model (see the module doc).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FoundationModel {
+    #[default]
+    Massless,
+    MassedFixed,
+    Radiating,
+}
+
+impl FoundationModel {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FoundationModel::Massless => "massless",
+            FoundationModel::MassedFixed => "massed_fixed",
+            FoundationModel::Radiating => "radiating",
+        }
+    }
+
+    /// Whether the rock carries mass (every model but the seed's).
+    pub fn massed(self) -> bool {
+        self != FoundationModel::Massless
+    }
+}
+
+/// `foundation` of a scene (field docs: docs/scenes.md).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FoundationScene {
+    /// "massless" (default), "massed_fixed" or "radiating".
+    #[serde(default)]
+    pub model: FoundationModel,
+    /// The rock's volume groups. Default: the materials marked `massless` (the seed's rock).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rock: Option<Vec<String>>,
+    /// Far-boundary face groups or group patterns (radiating: where the dashpots and the free
+    /// field's forces act). Default `["bc:far*"]` (the dam's bottom and four sides).
+    #[serde(default = "default_far")]
+    pub far: Vec<String>,
+    /// Add springs to the dashpots (the viscous-spring boundary of Liu et al. 2006:
+    /// k_n = 4/3 G/R, k_t = 2/3 G/R per unit area). Default false (pure Lysmer dashpots: no
+    /// static stiffness, the far boundary's static reactions are held as constant forces).
+    #[serde(default)]
+    pub springs: bool,
+    /// R of the springs [m]: distance from the scattering source (the dam) to the far boundary.
+    /// Default: each far face's distance to the centre of the rock's top.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spring_distance: Option<f64>,
+    /// Elevation of the free surface where the records were taken [m]. Default: the top of the
+    /// rock (the highest rock node; the canyon is ignored in the free field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface: Option<f64>,
+    /// Highest frequency of the free field [Hz]: the records are low-passed there before the
+    /// deconvolution. Default 25 (`problem::foundation::free_field::DEFAULT_MAX_FREQUENCY`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_frequency: Option<f64>,
+    /// Whether the massed rock carries its weight. Default false: the rock's in-situ state
+    /// predates the dam (as with the massless rock), so the static state is the same in every
+    /// model and only the dam's loads strain the rock.
+    #[serde(default)]
+    pub rock_weight: bool,
+}
+
+fn default_far() -> Vec<String> {
+    vec!["bc:far*".into()]
+}
+
+impl Default for FoundationScene {
+    fn default() -> Self {
+        FoundationScene { model: FoundationModel::Massless, rock: None, far: default_far(), springs: false, spring_distance: None, surface: None, max_frequency: None, rock_weight: false }
+    }
+}
+
+impl FoundationScene {
+    /// The rock's material entries: those named by `rock`, else those marked `massless`.
+    pub fn rock_materials<'a>(&self, materials: &'a [MaterialSpec]) -> Vec<&'a MaterialSpec> {
+        match &self.rock {
+            Some(groups) => materials.iter().filter(|m| groups.iter().any(|g| *g == m.group)).collect(),
+            None => materials.iter().filter(|m| m.massless).collect(),
+        }
+    }
+
+    /// The checks that need no mesh (`materials`: the scene's): each names the field and the fix.
+    pub fn validate(&self, materials: &[MaterialSpec]) -> Result<(), String> {
+        if self.model.massed() {
+            let rock = self.rock_materials(materials);
+            if rock.is_empty() {
+                return Err(format!(
+                    "foundation.model \"{}\": no rock material: mark the rock's material `massless` (the seed's rock) or name its volume groups in foundation.rock",
+                    self.model.as_str()
+                ));
+            }
+            if let Some(m) = rock.iter().find(|m| m.rho <= 0.0) {
+                return Err(format!("foundation.model \"{}\": the rock material \"{}\" has rho = 0; a massed rock needs its density [kg/m³]", self.model.as_str(), m.group));
+            }
+        }
+        let radiating_only = |set: bool, field: &str| -> Result<(), String> {
+            if set && self.model != FoundationModel::Radiating {
+                return Err(format!("foundation.{field}: only with \"model\": \"radiating\" (the model is \"{}\")", self.model.as_str()));
+            }
+            Ok(())
+        };
+        radiating_only(self.springs, "springs")?;
+        radiating_only(self.spring_distance.is_some(), "spring_distance")?;
+        radiating_only(self.surface.is_some(), "surface")?;
+        radiating_only(self.max_frequency.is_some(), "max_frequency")?;
+        if let Some(f) = self.max_frequency {
+            if !(f > 0.0 && f.is_finite()) {
+                return Err(format!("foundation.max_frequency = {f}: must be a frequency > 0 [Hz]"));
+            }
+        }
+        if self.far.is_empty() {
+            return Err("foundation.far: give at least one far-boundary face group (default [\"bc:far*\"])".into());
+        }
+        if let Some(r) = self.spring_distance {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(format!("foundation.spring_distance = {r}: must be a distance > 0 [m]"));
+            }
+            if !self.springs {
+                return Err("foundation.spring_distance: only with \"springs\": true".into());
+            }
+        }
+        if let Some(z) = self.surface {
+            if !z.is_finite() {
+                return Err(format!("foundation.surface = {z}: must be a finite elevation [m]"));
+            }
+        }
+        if let Some(r) = &self.rock {
+            if r.is_empty() {
+                return Err("foundation.rock: give the rock's volume groups, or leave it out (the massless materials)".into());
+            }
+        }
+        Ok(())
+    }
+}
