@@ -137,11 +137,11 @@ impl<'p> Simulation<'p> {
     /// not reached within `max_residual` is an error; one above `tolerance` only a note.
     pub fn equilibrate(&mut self) -> Result<Option<&EquilibriumInfo>, Error> {
         let sc = &self.problem.scene;
-        if (self.problem.loads.gravity.is_none() && self.problem.loads.static_forces.is_empty()) || sc.equilibrium.method != "relaxation" {
+        if (self.problem.loads.gravity.is_none() && self.problem.loads.static_forces.is_empty()) || sc.equilibrium.method != crate::scene::EquilibriumMethod::Relaxation {
             return Ok(None);
         }
         if let Some(c) = self.contact.as_mut() {
-            c.keep_bonds = sc.equilibrium.joint_bonds == "kept";
+            c.keep_bonds = sc.equilibrium.joint_bonds == crate::scene::JointBonds::Kept;
         }
         let eq = self.relax(sc.equilibrium.tolerance, sc.equilibrium.max_steps)?;
         if !eq.converged && eq.residual > sc.equilibrium.max_residual {

@@ -157,9 +157,9 @@ pub fn grout_pairs(problem: &Problem, contact: &mut ContactState, u: &[f64], whi
 pub fn equilibrate(sim: &mut Simulation<'_>) -> Result<SequenceReport, Error> {
     let p = sim.problem;
     let sc = &p.scene;
-    let sequence = sc.equilibrium.sequence.clone();
+    let sequence = sc.equilibrium.sequence.as_str().to_string();
     let mut stages = Vec::new();
-    let relaxing = sc.equilibrium.method == "relaxation" && (p.loads.gravity.is_some() || !p.loads.static_forces.is_empty());
+    let relaxing = sc.equilibrium.method == crate::scene::EquilibriumMethod::Relaxation && (p.loads.gravity.is_some() || !p.loads.static_forces.is_empty());
     match sequence.as_str() {
         "construction" if relaxing => {
             let (u, a) = self_weight_open_joints(p)?;

@@ -205,7 +205,7 @@ fn apply_pga(s: &mut Scene, pga: f64) -> Result<(), Error> {
             && sy.pga.is_none()
         {
             let ratio = crate::motion::SynthRequest::new(sy.spectrum.clone(), 1.0, sy.seed).vertical_ratio;
-            sy.pga = b.pga.map(|p| if sy.component == "v" { p / ratio } else { p });
+            sy.pga = b.pga.map(|p| if sy.component == crate::scene::SynthComponent::V { p / ratio } else { p });
         }
         b.scale = Some(m.scale * f);
         b.pga = None;
