@@ -620,6 +620,7 @@ fn real_main() -> Result<()> {
         Cmd::Study { action } => study_cmd(action)?,
         Cmd::Record { action } => record_cmd(action)?,
         Cmd::Testcase { kind, lower, upper, slave, method, penalty, layer, mu, tied, pressure, shear, inclination, massless_lower, duration, residual, edge_tolerance, offset, rotate, curvature, record, pga, out, run, json } => {
+            jointquake::testcase::check_finite_options(&[("curvature", curvature), ("offset", offset), ("rotate", rotate), ("pga", pga), ("edge_tolerance", edge_tolerance), ("penalty", penalty), ("mu", mu), ("pressure", pressure), ("shear", shear), ("inclination", inclination), ("duration", duration), ("residual", residual)])?;
             // the options as the study file writes a case (one parser and one set of checks)
             let mut o = serde_json::json!({"kind": kind, "tied": tied, "massless_lower": massless_lower});
             let opts: [(&str, serde_json::Value); 18] = [

@@ -73,18 +73,24 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
         }
         scene.time.duration = d;
     }
+    let phase = |name: &str| -> Result<(), Error> { crate::interrupt::check(name).map_err(|m| ModelError::Invalid(m).into()) };
     let mesh = load_mesh(&scene, opts)?;
+    phase("meshing")?;
     expand_patterns(&mut scene, &mesh, scene_path)?;
+    phase("the expansion of group patterns")?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");
     let problem = Problem::build(scene, mesh)?;
+    phase("the model's build (records, reservoir, joints)")?;
     laps.lap("model");
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
-        crate::statics::sequence::equilibrate(&mut sim)?;
-        laps.lap("equilibrium");
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
+        crate::output::recorder::check_outputs(&sim, &out_dir)?;
+        crate::statics::sequence::equilibrate(&mut sim)?;
+        phase("the static state")?;
+        laps.lap("equilibrium");
         inspect(&sim, &out_dir)?;
         let mut recorder = Recorder::create(&sim, &out_dir, opts.progress)?;
         sim.run(&mut recorder)?;
@@ -218,7 +224,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
     let blocks = crate::mesh::topology::Blocks::of(&mesh);
     let mut joints = Vec::with_capacity(scene.joints.len());
     let mut rows = Vec::with_capacity(scene.joints.len());
-    let stems: Vec<String> = scene.joints.iter().map(|j| crate::scene::joint_file_stem(&j.name)).collect();
+    let stems: Vec<String> = scene.joints.iter().map(|j| crate::files::file_stem(&j.name)).collect();
     for (j, stem) in scene.joints.iter().zip(&stems) {
         let spec = JointSpec { name: j.name.clone(), master: j.master.clone(), slave: j.slave.clone(), auto: j.auto };
         let (tolerance, source) = match j.tolerance {

@@ -123,6 +123,24 @@ impl Envelope {
     }
 }
 
+/// Most samples a generated record may have: 2^18 = 262 144 (600 s at 2.3 ms, 20 s at 0.08
+/// ms). Synthesis works on FFTs of twice that length per iteration; beyond it a record took
+/// minutes with no output, and `--dt 1e-9` aborted on a 48 GB allocation (issue 33).
+pub const MAX_SYNTH_SAMPLES: usize = 1 << 18;
+
+/// The sample count round(duration / dt) + 1 of a generated record checked against
+/// [`MAX_SYNTH_SAMPLES`] before anything is allocated; the error names `field` (the dt).
+pub fn check_sample_count(duration: f64, dt: f64, field: &str) -> Result<(), MotionError> {
+    let n = (duration / dt).round() + 1.0;
+    if !(n <= MAX_SYNTH_SAMPLES as f64) {
+        return Err(MotionError::invalid(
+            field,
+            format!("{dt} s over {duration} s is {n:.3e} samples, above the limit of {MAX_SYNTH_SAMPLES}: give a larger dt or a shorter duration"),
+        ));
+    }
+    Ok(())
+}
+
 /// Names of the components in order: two horizontal, then the vertical.
 pub const COMPONENT_NAMES: [&str; 3] = ["h1", "h2", "v"];
 
@@ -251,6 +269,7 @@ impl SynthRequest {
         if !(self.duration > 0.0 && self.duration.is_finite() && self.duration <= 600.0) {
             return Err(MotionError::invalid(f("duration"), format!("{} s must be in (0, 600]", self.duration)));
         }
+        check_sample_count(self.duration, self.dt, &f("dt"))?;
         self.envelope.check(self.duration, &f("envelope")).map_err(|e| match e {
             MotionError::Invalid { field: fl, message } if fl == "duration" => MotionError::Invalid { field: f("duration"), message },
             other => other,

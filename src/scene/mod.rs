@@ -815,16 +815,12 @@ impl JointSceneSpec {
     }
 }
 
-/// The file stem of a joint's outputs (`joints/<stem>.pvd`, `tagging/<stem>.vtu`): its name with
-/// every character other than letters, digits, `-`, `_` and `.` replaced by `_`.
-pub fn joint_file_stem(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' }).collect()
-}
+
 
 impl Scene {
     /// Read and validate a scene file; relative paths are resolved against its directory.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+        let text = crate::files::read_text_bounded(path, crate::files::MAX_TEXT_INPUT).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
         let mut scene: Scene = serde_json::from_str(&text).map_err(|e| SceneError::Parse {
             path: path.to_path_buf(),
             message: format!("{e} (see docs/scenes.md for the fields)"),
@@ -846,9 +842,8 @@ impl Scene {
         }
         if scene.name.is_none() {
             // From the file name, with the characters a name may not hold replaced by `_`.
-            let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
-            let clean: String = stem.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+') { c } else { '_' }).collect();
-            scene.name = Some(clean.trim_start_matches('.').to_string()).filter(|n| !n.is_empty()).or(Some("scene".into()));
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            scene.name = Some(if stem.is_empty() { "scene".into() } else { crate::files::file_stem(&stem) });
         }
         scene.validate().map_err(|message| SceneError::Invalid { path: path.to_path_buf(), message })?;
         Ok(scene)

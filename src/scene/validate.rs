@@ -19,13 +19,14 @@ impl Scene {
         validate_equilibrium(&self.equilibrium)?;
         validate_output(&self.output)?;
         validate_joints(&self.joints)?;
-        self.damping.coefficients()?;
+        validate_damping(&self.damping)?;
         if let Some(r) = &self.reservoir {
             validate_reservoir(r)?;
         }
         if !(self.g > 0.0) {
             return Err(format!("g = {} must be positive [m/s²]", self.g));
         }
+        check_range("g", self.g, G_RANGE, "m/s²")?;
         Ok(())
     }
 }
@@ -38,6 +39,11 @@ fn validate_geometry(g: &Geometry) -> Result<(), String> {
     }
     if g.msh.is_some() && !g.set.is_empty() {
         return Err("geometry.set: `-setnumber` parameters apply to a `.geo`, but this scene reads a ready `msh`. Remove `set`, or mesh the `.geo` instead.".into());
+    }
+    for (k, v) in &g.set {
+        if !v.is_finite() {
+            return Err(format!("geometry.set.{k} = {v} must be a finite number"));
+        }
     }
     Ok(())
 }
@@ -107,6 +113,7 @@ fn validate_base(base: &[BaseRecord]) -> Result<(), String> {
             if s.pga.is_none() && b.pga.is_none() {
                 return Err(format!("{l}: a synth entry needs the set's design PGA: give the entry's `pga` [g] (or `synth.pga`, the horizontal PGA the spectrum is drawn for, with `scale`)"));
             }
+            validate_synth(&l, s)?;
         }
         b.baseline.resolve().map_err(|e| format!("{l}: {e}"))?;
         if b.scale.is_some() && b.pga.is_some() {
@@ -124,9 +131,24 @@ fn validate_base(base: &[BaseRecord]) -> Result<(), String> {
             if !(sc > 0.0 && sc.is_finite()) {
                 return Err(format!("{l}: scale = {sc} must be positive. To reverse the record's polarity, reverse its `direction`."));
             }
+            check_range(&format!("{l}: scale"), sc, (0.0, MAX_SCALE), "(multiplier)")?;
         }
+        if let Some(pga) = b.pga {
+            check_range(&format!("{l}: pga"), pga, (0.0, MAX_PGA), "g")?;
+        }
+        check_finite_vector(&format!("{l}: direction"), &b.direction, MAX_COORD)?;
     }
     Ok(())
+}
+
+/// A generated record's own fields: its PGA, and its length and step through the one rule of
+/// `record synth` (`motion::synth::check_sample_count`), so a scene is refused as the command is.
+fn validate_synth(l: &str, s: &BaseSynth) -> Result<(), String> {
+    if let Some(p) = s.pga {
+        check_range(&format!("{l}: synth.pga"), p, (f64::MIN_POSITIVE, MAX_PGA), "g")?;
+    }
+    // the ranges of dt and duration are `record synth`'s, checked when the record is made
+    crate::motion::synth::check_sample_count(s.duration, s.dt, "synth.dt").map_err(|e| format!("{l}: {e}"))
 }
 
 fn validate_static_loads(loads: &Loads) -> Result<(), String> {
@@ -137,12 +159,18 @@ fn validate_static_loads(loads: &Loads) -> Result<(), String> {
         if !(g.g > 0.0 && g.g.is_finite()) {
             return Err(format!("loads.gravity.g = {} must be positive [m/s²] (default 9.81); the direction gives the sense", g.g));
         }
+        check_range("loads.gravity.g", g.g, G_RANGE, "m/s²")?;
+        check_finite_vector("loads.gravity.direction", &g.direction, MAX_COORD)?;
+        if let Some(groups) = &g.groups {
+            check_no_repeat("loads.gravity.groups", groups, "its weight would count twice")?;
+        }
     }
     for (k, t) in loads.traction.iter().enumerate() {
         check_load(&format!("loads.traction[{k}] (group \"{}\")", t.group), "traction", &t.traction, MAX_TRACTION, "Pa", t.ramp)?;
     }
     for (k, f) in loads.nodal.iter().enumerate() {
         check_load(&format!("loads.nodal[{k}]"), "force", &f.force, MAX_FORCE, "N", f.ramp)?;
+        check_finite_vector(&format!("loads.nodal[{k}].point"), &f.point, MAX_COORD)?;
     }
     Ok(())
 }
@@ -172,6 +200,22 @@ fn validate_time(time: &TimeSpec) -> Result<(), String> {
     if time.dt.is_some() && time.courant.is_some() {
         return Err("time: give `dt` or `courant`, not both".into());
     }
+    check_range("time.energy_tolerance", time.energy_tolerance, (0.0, MAX_ENERGY_TOLERANCE), "(fraction of the energy scale)")?;
+    if let Some(ms) = &time.mass_scaling {
+        check_range("time.mass_scaling.target_dt", ms.target_dt, (0.0, MAX_DT), "s")?;
+    }
+    if let Some(dt) = time.dt {
+        check_range("time.dt", dt, (0.0, MAX_DT), "s")?;
+        if time.duration > 0.0 && dt > 2.0 * time.duration {
+            return Err(format!(
+                "time.dt = {dt} s is more than twice time.duration = {} s: the run would take no dynamic step. Give a smaller dt (or leave it out: the stable step is used), or a longer duration",
+                time.duration
+            ));
+        }
+    }
+    if time.max_steps > MAX_MAX_STEPS {
+        return Err(format!("time.max_steps = {} is above the limit {MAX_MAX_STEPS:e} (weeks of computing on one core)", time.max_steps));
+    }
     Ok(())
 }
 
@@ -182,6 +226,11 @@ fn validate_equilibrium(eq: &EquilibriumSpec) -> Result<(), String> {
     if !(eq.max_residual > 0.0 && eq.max_residual.is_finite()) {
         return Err(format!("equilibrium.max_residual = {} must be positive (default 1e-3)", eq.max_residual));
     }
+    check_range("equilibrium.tolerance", eq.tolerance, (0.0, 1.0), "(relative residual)")?;
+    check_range("equilibrium.max_residual", eq.max_residual, (0.0, 1.0), "(relative residual)")?;
+    if eq.max_steps > MAX_RELAX_STEPS {
+        return Err(format!("equilibrium.max_steps = {} is above the limit {MAX_RELAX_STEPS:e}", eq.max_steps));
+    }
     Ok(())
 }
 
@@ -190,6 +239,7 @@ fn validate_output(out: &OutputSpec) -> Result<(), String> {
         if e.faces.is_empty() || e.stride == 0 {
             return Err("output.envelope: give at least one face group in `faces` and a `stride` ≥ 1 [steps]".into());
         }
+        check_no_repeat("output.envelope.faces", &e.faces, "its envelope would be written twice")?;
     }
     if out.frame_stride.is_some() && out.frame_interval.is_some() {
         return Err("output: give `frame_stride` or `frame_interval`, not both".into());
@@ -210,9 +260,15 @@ fn validate_output(out: &OutputSpec) -> Result<(), String> {
     if out.frame_stride == Some(0) {
         return Err("output.frame_stride must be at least 1".into());
     }
+    for (name, v) in [("output.frame_interval", out.frame_interval), ("output.history_interval", out.history_interval)] {
+        if let Some(x) = v {
+            check_range(name, x, (0.0, MAX_DURATION), "s")?;
+        }
+    }
     let mut monitors = std::collections::BTreeSet::new();
     for m in &out.monitor {
         check_file_name("output.monitor name", &m.name)?;
+        check_finite_vector(&format!("output.monitor \"{}\": point", m.name), &m.point, MAX_COORD)?;
         if !monitors.insert(m.name.as_str()) {
             return Err(format!("output.monitor: two monitors are named \"{}\" (each writes histories/{}.csv): give each its own name", m.name, m.name));
         }
@@ -232,7 +288,7 @@ fn validate_joints(joints: &[JointSceneSpec]) -> Result<(), String> {
         if j.name.is_empty() {
             return Err("joints: a joint has an empty `name`".into());
         }
-        let stem = joint_file_stem(&j.name);
+        let stem = crate::files::file_stem(&j.name);
         if let Some(other) = joint_stems.get(&stem) {
             return Err(format!("joint \"{}\": its output file name \"{stem}.vtu\" is also that of joint \"{other}\"; give the joints distinct names", j.name));
         }
@@ -247,6 +303,47 @@ fn validate_joints(joints: &[JointSceneSpec]) -> Result<(), String> {
         if j.master == j.slave {
             return Err(format!("joint \"{}\": master and slave are the same group \"{}\"", j.name, j.master));
         }
+        validate_joint_numbers(j)?;
+    }
+    Ok(())
+}
+
+/// The numbers of one joint within their physical ranges (the signs and the layer are checked
+/// again where the law is built, `contact::joint`).
+fn validate_joint_numbers(j: &JointSceneSpec) -> Result<(), String> {
+    let f = |field: &str| format!("joint \"{}\": {field}", j.name);
+    let bounded = [
+        ("tolerance", j.tolerance, (0.0, MAX_COORD), "m"),
+        ("mu", j.mu, (0.0, MAX_MU), "(friction coefficient)"),
+        ("phi", j.phi, (0.0, MAX_PHI_DEG), "deg"),
+        ("cohesion", j.cohesion, (0.0, MAX_STRENGTH), "Pa"),
+        ("tensile_strength", j.tensile_strength, (0.0, MAX_STRENGTH), "Pa"),
+        ("softening_slip", j.softening_slip, (0.0, MAX_COORD), "m"),
+        ("penalty_stiffness", j.penalty_stiffness, (0.0, MAX_PENALTY), "Pa/m"),
+        ("edge_tolerance", j.edge_tolerance, (0.0, 0.5), "(fraction of the face size)"),
+    ];
+    for (field, v, range, unit) in bounded {
+        if let Some(x) = v {
+            check_range(&f(field), x, range, unit)?;
+        }
+    }
+    if let Some(t) = j.tolerance {
+        if t <= 0.0 {
+            return Err(format!("{} = {t} must be positive [m]", f("tolerance")));
+        }
+    }
+    Ok(())
+}
+
+fn validate_damping(d: &Damping) -> Result<(), String> {
+    d.coefficients()?;
+    for (field, v, max, unit) in [("alpha", d.alpha, MAX_ALPHA, "1/s"), ("beta", d.beta, MAX_BETA, "s"), ("f1", d.f1, MAX_FREQUENCY, "Hz"), ("f2", d.f2, MAX_FREQUENCY, "Hz")] {
+        if let Some(x) = v {
+            check_range(&format!("damping.{field}"), x, (0.0, max), unit)?;
+        }
+    }
+    if let Some(g) = &d.mass_groups {
+        check_no_repeat("damping.mass_groups", g, "a repeat is not a larger damping")?;
     }
     Ok(())
 }
@@ -265,9 +362,87 @@ fn validate_reservoir(r: &ReservoirScene) -> Result<(), String> {
         if !(b < r.level) {
             return Err(format!("reservoir.bottom = {b} m must be below the pool level {} m", r.level));
         }
+        check_range("reservoir.bottom", b, (-MAX_ELEVATION, MAX_ELEVATION), "m")?;
+    }
+    check_range("reservoir.level", r.level, (-MAX_ELEVATION, MAX_ELEVATION), "m")?;
+    check_range("reservoir.rho_w", r.rho_w, RHO_W_RANGE, "kg/m³")?;
+    check_no_repeat("reservoir.faces", &r.faces, "its water pressure and added mass would be applied twice")?;
+    Ok(())
+}
+
+/// `value` finite and within `range` (inclusive), else an error naming `field`, the value, the
+/// range and the unit: the one form of every bound below.
+fn check_range(field: &str, value: f64, range: (f64, f64), unit: &str) -> Result<(), String> {
+    if !(value >= range.0 && value <= range.1) {
+        return Err(format!("{field} = {value:e} is outside the accepted range [{:e}, {:e}] {unit} (docs/scenes.md)", range.0, range.1));
     }
     Ok(())
 }
+
+/// Every component of `v` finite and at most `max` in size.
+fn check_finite_vector(field: &str, v: &[f64; 3], max: f64) -> Result<(), String> {
+    if v.iter().any(|c| !(c.abs() <= max)) {
+        return Err(format!("{field} = {v:?} must be finite with components of at most {max:e}"));
+    }
+    Ok(())
+}
+
+/// A list of groups where a repeat would change the physics (or the outputs): refused, naming
+/// the group and `why`.
+fn check_no_repeat(field: &str, list: &[String], why: &str) -> Result<(), String> {
+    let mut seen = std::collections::BTreeSet::new();
+    for g in list {
+        if !seen.insert(g.as_str()) {
+            return Err(format!("{field}: \"{g}\" is listed twice ({why}); list each group once"));
+        }
+    }
+    Ok(())
+}
+
+/// Standard gravity `g` and `loads.gravity.g` accepted [m/s²]: 0.1 to 100, from a small moon to
+/// ten times the Earth's, the range of the record commands' `--g` (one definition there).
+/// Outside, the unit is wrong (1e300 ran to inf peaks, issue 33).
+pub const G_RANGE: (f64, f64) = crate::motion::commands::G_RANGE;
+/// Largest peak ground acceleration (`pga`, `synth.pga`) [g]: 10, more than twice the largest
+/// ever recorded (about 4 g); beyond it the unit is wrong (1e300 ran to inf peaks).
+pub const MAX_PGA: f64 = 10.0;
+/// Largest `scale` of a record [-]: 100 (a record in cm/s² read as g would need 1/981; a
+/// scale above 100 is a unit mistake, and 1e300 ran to inf peaks).
+pub const MAX_SCALE: f64 = 100.0;
+/// Largest coordinate or length a scene may give [m] (points, directions, tolerances,
+/// softening slip): 10⁷, the size of the Earth; keeps every distance far inside f64.
+pub const MAX_COORD: f64 = 1e7;
+/// Largest |elevation| of a pool level or reservoir bottom [m]: 10⁵, beyond any site on Earth
+/// (a level of 1e308 reached an assertion in the mass assembly, issue 33).
+pub const MAX_ELEVATION: f64 = 1e5;
+/// Water density accepted [kg/m³]: 500 to 3000, from light oil to a heavy mud (fresh water
+/// 1000, sea water 1025).
+pub const RHO_W_RANGE: (f64, f64) = (500.0, 3000.0);
+/// Largest time step and `mass_scaling.target_dt` [s]: 1 (a step of a second resolves no
+/// earthquake frequency).
+pub const MAX_DT: f64 = 1.0;
+/// Largest output interval (`frame_interval`, `history_interval`) [s]: 10⁶ (11.6 days).
+pub const MAX_DURATION: f64 = 1e6;
+/// Largest `time.energy_tolerance` [-]: 10 (an error ten times the energy scale; above it the
+/// check is off in all but name).
+pub const MAX_ENERGY_TOLERANCE: f64 = 10.0;
+/// Largest `time.max_steps`: 10¹² (weeks of a 10⁴-element model on one core).
+pub const MAX_MAX_STEPS: u64 = 1_000_000_000_000;
+/// Largest `equilibrium.max_steps`: 10⁹.
+pub const MAX_RELAX_STEPS: usize = 1_000_000_000;
+/// Largest Rayleigh α [1/s]: 10⁴ (critical damping of a 800 Hz mode; the joint-test rig uses
+/// 3142); β [s]: 1 (critical damping at 0.3 Hz, far below any structure's modes); `f1`, `f2`
+/// [Hz]: 10⁴. Beyond these the stable step overflowed and the run said "no element has mass".
+pub const MAX_ALPHA: f64 = 1e4;
+pub const MAX_BETA: f64 = 1.0;
+pub const MAX_FREQUENCY: f64 = 1e4;
+/// Largest joint friction coefficient μ [-]: 10 (φ = 84°), and angle φ [deg]: 89.
+pub const MAX_MU: f64 = 10.0;
+pub const MAX_PHI_DEG: f64 = 89.0;
+/// Largest joint cohesion and tensile strength [Pa]: 10¹⁰ (ten times the strongest rock).
+pub const MAX_STRENGTH: f64 = 1e10;
+/// Largest penalty stiffness [Pa/m]: 10¹⁶ (10⁵ E/h for E = 100 GPa, h = 1 m).
+pub const MAX_PENALTY: f64 = 1e16;
 
 /// Young's modulus accepted [Pa]: 1 kPa (a very soft soil) to 10 TPa (ten times diamond). Outside
 /// this the input is in the wrong unit, and the stable step becomes absurd (E 1e307 Pa would
@@ -296,8 +471,7 @@ fn check_load(what: &str, field: &str, v: &[f64; 3], max: f64, unit: &str, ramp:
 /// letters, digits, `_`, `-`, `.`, `:`, `+`, not starting with `.`, 1–100 characters, so that
 /// no name writes outside the output directory or makes a hidden file.
 pub fn check_file_name(field: &str, name: &str) -> Result<(), String> {
-    let ok_char = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+');
-    if name.is_empty() || name.len() > 100 || name.starts_with('.') || !name.chars().all(ok_char) {
+    if name.is_empty() || !crate::files::is_file_stem(name) {
         return Err(format!(
             "{field} \"{name}\" becomes a file name: use 1–100 letters, digits, `_`, `-`, `.` or `+`, not starting with `.` (no `/`, spaces or `..`)"
         ));

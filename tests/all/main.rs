@@ -13,6 +13,7 @@ mod dam_physics;
 mod dam_study;
 mod dynamics;
 mod fuzz;
+mod hardening;
 mod joint_tests;
 mod mesh;
 mod motion;
