@@ -142,13 +142,13 @@ fn validate_base(base: &[BaseRecord]) -> Result<(), String> {
 }
 
 /// A generated record's own fields: its PGA, and its length and step through the one rule of
-/// `record synth` (`motion::synth::check_sample_count`), so a scene is refused as the command is.
+/// `record synth` (`motion::synth::check_sampling`), so a scene is refused as the command is.
 fn validate_synth(l: &str, s: &BaseSynth) -> Result<(), String> {
     if let Some(p) = s.pga {
         check_range(&format!("{l}: synth.pga"), p, (f64::MIN_POSITIVE, MAX_PGA), "g")?;
     }
     // the ranges of dt and duration are `record synth`'s, checked when the record is made
-    crate::motion::synth::check_sample_count(s.duration, s.dt, "synth.dt").map_err(|e| format!("{l}: {e}"))
+    crate::motion::synth::check_sampling(s.duration, s.dt, "synth.dt").map_err(|e| format!("{l}: {e}"))
 }
 
 fn validate_static_loads(loads: &Loads) -> Result<(), String> {

@@ -83,16 +83,19 @@ fn reservoir_level_1e308_and_bottom_minus_1e308_are_refused_not_an_assertion() {
 #[test]
 fn synth_sample_count_above_the_limit_is_refused_before_allocating() {
     // Before: `memory allocation of N bytes failed` (dt 1e-9), or a run with no output for
-    // dt 1e-5. Limit: motion::synth::MAX_SYNTH_SAMPLES (2^18).
+    // dt 1e-5. Limits: motion::synth::MIN_SYNTH_DT (5 ms), MAX_SYNTH_SAMPLES (120 001).
     let mut s = column_scene();
     s["loads"] = json!({"base": [{"synth": {"spectrum": {"kind": "table", "points": [[0.1, 1.0], [1.0, 1.0]]}, "seed": 1, "dt": 1e-9}, "direction": [1, 0, 0], "pga": 0.2}]});
-    assert_mentions(&run_error("synth_dt_1e-9", &s), &["loads.base[0]", "synth.dt", "samples", "262144"]);
+    assert_mentions(&run_error("synth_dt_1e-9", &s), &["loads.base[0]", "synth.dt", "must be in [0.005, 0.05]"]);
+    s["loads"]["base"][0]["synth"]["dt"] = json!(0.005);
+    s["loads"]["base"][0]["synth"]["duration"] = json!(1e6);
+    assert_mentions(&run_error("synth_1e6_s", &s), &["synth.dt", "2.000e8 samples", "120001"]);
     // the same rule for `record synth`
     let mut req = jointquake::motion::synth::SynthRequest::new(jointquake::motion::TargetSpec::Table { points: Some(vec![[0.1, 1.0], [1.0, 1.0]]), file: None }, 0.2, 1);
     req.dt = 1e-6;
     req.duration = 600.0;
     let e = req.check("").unwrap_err().to_string();
-    assert_mentions(&e, &["dt", "6.000e8 samples", "262144"]);
+    assert_mentions(&e, &["dt", "must be in [0.005, 0.05]"]);
 }
 
 #[test]
