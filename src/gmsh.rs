@@ -54,6 +54,47 @@ fn wheel_script_command(g: &Path) -> Option<Vec<String>> {
     py.exists().then(|| vec![py.to_string_lossy().into_owned(), g.to_string_lossy().into_owned()])
 }
 
+/// The parameters a `.geo` declares: the names before `=` at the top level of each
+/// `DefineConstant[ … ];` list (`H = {20, Min 1, Name "Parameters/H"}` gives `H`), the only
+/// names `-setnumber` changes.
+pub fn geo_parameters(text: &str) -> std::collections::BTreeSet<String> {
+    let mut out = std::collections::BTreeSet::new();
+    let mut rest = text;
+    while let Some(i) = rest.find("DefineConstant") {
+        rest = &rest[i + "DefineConstant".len()..];
+        let Some(open) = rest.find('[') else { break };
+        let body = &rest[open + 1..];
+        let (mut depth, mut end, mut entry_start) = (0i32, body.len(), 0usize);
+        let mut entries = Vec::new();
+        for (k, c) in body.char_indices() {
+            match c {
+                '{' | '(' => depth += 1,
+                '}' | ')' => depth -= 1,
+                ',' if depth == 0 => {
+                    entries.push(&body[entry_start..k]);
+                    entry_start = k + 1;
+                }
+                ']' if depth == 0 => {
+                    end = k;
+                    break;
+                }
+                _ => {}
+            }
+        }
+        entries.push(&body[entry_start..end]);
+        for e in entries {
+            if let Some((name, _)) = e.split_once('=') {
+                let name = name.trim();
+                if !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                    out.insert(name.to_string());
+                }
+            }
+        }
+        rest = &body[end.min(body.len())..];
+    }
+    out
+}
+
 /// Cache key of a `.geo` and its parameters.
 fn cache_key(geo_text: &str, set: &BTreeMap<String, f64>) -> String {
     let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -68,7 +109,20 @@ fn cache_key(geo_text: &str, set: &BTreeMap<String, f64>) -> String {
 /// Mesh `geo` in 3-D with the given `-setnumber` parameters into `cache_dir`, reusing a cached
 /// mesh when the `.geo` text and parameters are unchanged. Returns the `.msh` path.
 pub fn mesh_geo(geo: &Path, set: &BTreeMap<String, f64>, cache_dir: &Path) -> Result<PathBuf, GmshError> {
-    let text = std::fs::read_to_string(geo).map_err(|_| GmshError::MissingGeo { path: geo.to_path_buf() })?;
+    let text = match crate::files::read_text_bounded(geo, crate::files::MAX_TEXT_INPUT) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(GmshError::MissingGeo { path: geo.to_path_buf() }),
+        Err(e) => return Err(GmshError::Failed { geo: geo.to_path_buf(), log: geo.to_path_buf(), message: format!("cannot read the script: {e}") }),
+    };
+    let declared = geo_parameters(&text);
+    if let Some(unknown) = set.keys().find(|k| !declared.contains(k.as_str())) {
+        let known = declared.into_iter().collect::<Vec<_>>().join(", ");
+        return Err(GmshError::Failed {
+            geo: geo.to_path_buf(),
+            log: geo.to_path_buf(),
+            message: format!("not meshed: geometry.set names \"{unknown}\", which the script does not declare in a DefineConstant (gmsh would ignore it silently). Its parameters: {}", if known.is_empty() { "none".into() } else { known }),
+        });
+    }
     std::fs::create_dir_all(cache_dir).map_err(|source| GmshError::Io { path: cache_dir.to_path_buf(), source })?;
     let stem = geo.file_stem().and_then(|s| s.to_str()).unwrap_or("mesh");
     let key = cache_key(&text, set);
@@ -86,12 +140,14 @@ pub fn mesh_geo(geo: &Path, set: &BTreeMap<String, f64>, cache_dir: &Path) -> Re
     for (k, v) in set {
         c.arg("-setnumber").arg(k).arg(format!("{v}"));
     }
-    let out = c.output().map_err(|source| GmshError::Spawn { exe: cmd.join(" "), source })?;
-    let mut all = String::from_utf8_lossy(&out.stdout).into_owned();
-    all.push_str(&String::from_utf8_lossy(&out.stderr));
+    let (status, all) = run_child(&mut c).map_err(|source| GmshError::Spawn { exe: cmd.join(" "), source })?;
     std::fs::write(&log, &all).map_err(|source| GmshError::Io { path: log.clone(), source })?;
+    if crate::interrupt::interrupted() {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(GmshError::Failed { geo: geo.to_path_buf(), log, message: "interrupted (Ctrl-C or SIGTERM): gmsh was stopped".into() });
+    }
     let errors: Vec<&str> = all.lines().filter(|l| l.starts_with("Error")).collect();
-    if !out.status.success() || !errors.is_empty() || !tmp.exists() {
+    if !status.success() || !errors.is_empty() || !tmp.exists() {
         let _ = std::fs::remove_file(&tmp);
         let message = if errors.is_empty() {
             let tail: Vec<&str> = all.lines().rev().take(8).collect();
@@ -105,9 +161,73 @@ pub fn mesh_geo(geo: &Path, set: &BTreeMap<String, f64>, cache_dir: &Path) -> Re
     Ok(msh)
 }
 
+/// Run gmsh as a child that ends with the run: in its own process group (a terminal's Ctrl-C
+/// reaches only jointquake, which decides), killed when jointquake's interrupt flag is set
+/// (polled every [`CHILD_POLL`]) and, through `PR_SET_PDEATHSIG`, when jointquake itself dies,
+/// even by SIGKILL (the gmsh child outlived its parent, issue 34). Its output is collected by
+/// two reader threads (a full pipe would block it). Returns the exit status and stdout+stderr.
+fn run_child(c: &mut Command) -> std::io::Result<(std::process::ExitStatus, String)> {
+    use std::io::Read;
+    use std::os::unix::process::CommandExt;
+    c.process_group(0).stdin(std::process::Stdio::null()).stdout(std::process::Stdio::piped()).stderr(std::process::Stdio::piped());
+    // SAFETY: prctl is async-signal-safe and touches no memory of the parent.
+    unsafe {
+        c.pre_exec(|| {
+            if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) != 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            Ok(())
+        });
+    }
+    let mut child = c.spawn()?;
+    let reader = |r: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut s = Vec::new();
+            if let Some(mut r) = r {
+                let _ = r.read_to_end(&mut s);
+            }
+            s
+        })
+    };
+    let out = reader(child.stdout.take().map(|r| Box::new(r) as Box<dyn Read + Send>));
+    let err = reader(child.stderr.take().map(|r| Box::new(r) as Box<dyn Read + Send>));
+    let status = loop {
+        if let Some(s) = child.try_wait()? {
+            break s;
+        }
+        if crate::interrupt::interrupted() {
+            let _ = child.kill();
+            break child.wait()?;
+        }
+        std::thread::sleep(CHILD_POLL);
+    };
+    let mut all = String::from_utf8_lossy(&out.join().unwrap_or_default()).into_owned();
+    all.push_str(&String::from_utf8_lossy(&err.join().unwrap_or_default()));
+    Ok((status, all))
+}
+
+/// How often a running gmsh child is checked for the interrupt flag: 50 ms (an interrupt ends
+/// it within that; the poll costs nothing next to meshing).
+const CHILD_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn unknown_geometry_set_name_is_refused_before_meshing() {
+        // Regression (issue 34): a misspelt `geometry.set` name was passed to gmsh, which
+        // ignored it. Reference: the DefineConstant names of geo/column.geo.
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/geo/column.geo")).unwrap();
+        let names: Vec<String> = geo_parameters(&text).into_iter().collect();
+        assert_eq!(names, ["H", "nw", "nz", "tets", "w"]);
+        let d = std::env::temp_dir().join(format!("jq-gmsh-set-{}", std::process::id()));
+        let mut set = BTreeMap::new();
+        set.insert("Hh".to_string(), 20.0);
+        let e = mesh_geo(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/geo/column.geo")), &set, &d).unwrap_err().to_string();
+        assert!(e.contains("\"Hh\"") && e.contains("H, nw, nz, tets, w"), "{e}");
+        assert!(!d.exists(), "nothing written before the check");
+    }
 
     #[test]
     fn gmsh_env_naming_the_wheel_script_runs_it_with_the_venv_python() {

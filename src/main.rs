@@ -691,6 +691,7 @@ fn cmd_wedge_fs(input: Option<PathBuf>, height_def: Option<HeightDefArg>, h: Opt
 
 /// `jointquake testcase`: write the case (and with `--run` solve it and print its error).
 fn cmd_testcase(args: TestcaseArgs) -> Result<()> {
+    jointquake::testcase::check_finite_options(&[("penalty", args.penalty), ("mu", args.mu), ("pressure", args.pressure), ("shear", args.shear), ("inclination", args.inclination), ("duration", args.duration), ("residual", args.residual), ("pga", args.pga), ("edge_tolerance", args.edge_tolerance), ("offset", args.offset), ("rotate", args.rotate), ("curvature", args.curvature)])?;
     // the options as the study file writes a case (one parser and one set of checks)
     let value = serde_json::to_value(&args).context("testcase options (docs/cli.md, `testcase`)")?;
     let spec: jointquake::testcase::CaseSpec = serde_json::from_value(value).context("testcase options (docs/cli.md, `testcase`)")?;

@@ -56,8 +56,16 @@ pub fn load_mesh(scene: &Scene, mesh_cache: Option<&Path>) -> Result<Mesh, Error
 /// file, or for a scene built in memory the file it came from).
 pub fn load_scene_mesh(scene: &mut Scene, scene_path: &Path, mesh_cache: Option<&Path>) -> Result<Mesh, Error> {
     let mesh = load_mesh(scene, mesh_cache)?;
+    interrupt_phase("meshing")?;
     expand_patterns(scene, &mesh, scene_path)?;
+    interrupt_phase("the expansion of group patterns")?;
     Ok(mesh)
+}
+
+/// Ends a run between its phases when SIGINT/SIGTERM arrived (`crate::interrupt`), naming the
+/// phase that had finished.
+fn interrupt_phase(name: &str) -> Result<(), Error> {
+    crate::interrupt::check(name).map_err(|m| ModelError::Invalid(m).into())
 }
 
 /// Expand the scene's group patterns against the mesh ([`crate::scene::patterns`]) and check
@@ -90,17 +98,21 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
         }
         scene.time.duration = d;
     }
+    let phase = interrupt_phase;
     let mesh = load_scene_mesh(&mut scene, scene_path, opts.mesh_cache.as_deref())?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");
     let problem = Problem::build(scene, mesh)?;
+    phase("the model's build (records, reservoir, joints)")?;
     laps.lap("model");
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
         let mut sim = Simulation::new(&problem)?;
-        sim.equilibrate()?;
-        laps.lap("equilibrium");
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
+        crate::output::recorder::check_outputs(&sim, &out_dir)?;
+        sim.equilibrate()?;
+        phase("the static state")?;
+        laps.lap("equilibrium");
         inspect(&sim, &out_dir)?;
         let mut recorder = Recorder::create(&sim, &out_dir, opts.progress)?;
         sim.run(&mut recorder)?;
@@ -230,7 +242,7 @@ pub fn tag(scene_path: &Path, opts: &RunOptions) -> Result<TagSummary, Error> {
     let blocks = crate::mesh::topology::Blocks::of(&mesh);
     let mut joints = Vec::with_capacity(scene.joints.len());
     let mut rows = Vec::with_capacity(scene.joints.len());
-    let stems: Vec<String> = scene.joints.iter().map(|j| crate::scene::joint_file_stem(&j.name)).collect();
+    let stems: Vec<String> = scene.joints.iter().map(|j| crate::files::file_stem(&j.name)).collect();
     for (j, stem) in scene.joints.iter().zip(&stems) {
         let spec = JointSpec { name: j.name.clone(), master: j.master.clone(), slave: j.slave.clone(), auto: j.auto };
         let (tolerance, source) = crate::contact::joint::joint_tolerance(j.tolerance, model_size);

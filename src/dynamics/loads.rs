@@ -9,7 +9,7 @@ use super::record::Record;
 use crate::error::{Error, ModelError};
 use crate::interface::{face_nodal_weights_into, FaceWeights};
 use crate::model::Model;
-use crate::motion::synth::{COMPONENT_NAMES, synthesize_components};
+use crate::motion::synth::synthesize_components;
 use crate::motion::{Baseline, Drift, MotionError, SynthRequest, correct, drift};
 use crate::scene::{BaseRecord, BaseSynth, Scene};
 use std::path::PathBuf;
@@ -113,7 +113,7 @@ fn base_motion(scene: &Scene, k: usize, b: &BaseRecord) -> Result<(BaseMotion, S
 /// code, [`synthesize_components`], so the same samples as that command's file), as a record
 /// in m/s², and the words naming it.
 fn synth_record(scene: &Scene, b: &BaseRecord, s: &BaseSynth, field: &str) -> Result<(Record, String), MotionError> {
-    let c = COMPONENT_NAMES.iter().position(|n| *n == s.component).ok_or_else(|| MotionError::invalid(format!("{field}.component"), format!("\"{}\" must be \"h1\", \"h2\" or \"v\"", s.component)))?;
+    let c = s.component.index();
     let mut req = SynthRequest::new(s.spectrum.clone(), 1.0, s.seed);
     req.duration = s.duration;
     req.dt = s.dt;

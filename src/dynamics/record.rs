@@ -32,7 +32,7 @@ pub const MIN_RECORD_DT: f64 = 1e-7;
 impl Record {
     /// Read a record in g and convert to m/s² with `g` [m/s²].
     pub fn read(path: &Path, g: f64) -> Result<Record, RecordError> {
-        let text = std::fs::read_to_string(path).map_err(|source| RecordError::Io { path: path.to_path_buf(), source })?;
+        let text = crate::files::read_text_bounded(path, crate::files::MAX_RECORD_INPUT).map_err(|source| RecordError::Io { path: path.to_path_buf(), source })?;
         // A UTF-8 byte-order mark (spreadsheets on Windows write one) is not part of the data.
         let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let is_at2 = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("at2"));

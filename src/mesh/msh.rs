@@ -12,7 +12,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::PathBuf;
 
 pub(super) fn read_msh(path: PathBuf) -> Result<Mesh, MeshError> {
-    let bytes = std::fs::read(&path).map_err(|source| MeshError::Io { path: path.clone(), source })?;
+    let bytes = crate::files::read_bounded(&path, crate::files::MAX_MESH_INPUT).map_err(|source| MeshError::Io { path: path.clone(), source })?;
     parse_msh(&bytes, path)
 }
 

@@ -14,7 +14,14 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// `record info`: measures, the 5 % spectrum on 0.02–10 s (CSV) and charts in `out`.
+///
+/// `name` (usually the record file's stem) becomes the files' stem through the one rule
+/// `files::file_stem`; `g` [m/s²] must be in `scene::G_RANGE`-like bounds (0.1–100; `--g
+/// -9.81` was accepted, issue 34).
 pub fn info(name: &str, t0: f64, dt: f64, accel_si: &[f64], g: f64, out: &Path) -> Result<String, MotionError> {
+    check_g(g)?;
+    let stem = crate::files::file_stem(name);
+    let name = stem.as_str();
     let periods = default_periods();
     let psa = response_spectrum(accel_si, dt, &periods, 0.05);
     let m = intensity_measures(accel_si, dt, t0, g, &periods, &psa);
@@ -49,6 +56,7 @@ pub fn info(name: &str, t0: f64, dt: f64, accel_si: &[f64], g: f64, out: &Path) 
 
 /// `record correct`: the corrected record to `out_file`, with the drift before and after.
 pub fn correct_file(source: &Path, t0: f64, dt: f64, accel_si: &[f64], g: f64, method: &Baseline, out_file: &Path) -> Result<String, MotionError> {
+    check_g(g)?;
     let before = drift(accel_si, dt);
     // the high-pass keeps its padding (the acausal filter's response before t0 is part of it)
     let (t0, c) = match *method {
@@ -73,6 +81,18 @@ pub fn correct_file(source: &Path, t0: f64, dt: f64, accel_si: &[f64], g: f64, m
     Ok(format!("{}\n  before: {}\n  after:  {}\n  written {}\n", header[0], before.describe(), after.describe(), out_file.display()))
 }
 
+/// Standard gravity of the record commands (`--g`) accepted [m/s²]: 0.1 to 100 (as a scene's
+/// `g`); a negative or non-finite one turned every acceleration around or into NaN.
+pub const G_RANGE: (f64, f64) = (0.1, 100.0);
+
+/// `g` within [`G_RANGE`], else an error naming `--g`.
+pub fn check_g(g: f64) -> Result<(), MotionError> {
+    if !(g >= G_RANGE.0 && g <= G_RANGE.1) {
+        return Err(MotionError::invalid("--g", format!("{g} m/s² must be in [{}, {}] (standard gravity 9.81; the sign is not a direction)", G_RANGE.0, G_RANGE.1)));
+    }
+    Ok(())
+}
+
 /// The CLI arguments that select `method`.
 pub fn method_args(method: &Baseline) -> String {
     match method {
@@ -83,7 +103,15 @@ pub fn method_args(method: &Baseline) -> String {
 }
 
 /// `record synth`: `<out>/<name>_s<seed>_<component>.txt`, a spectrum chart per component.
+/// `name` must be a file stem (`files::is_file_stem`): an absolute or `..` name would write
+/// outside `out` (issue 33), so it is refused, naming `--name`.
 pub fn synth_files(req: &SynthRequest, out: &Path, name: &str) -> Result<(String, Vec<PathBuf>), MotionError> {
+    if !crate::files::is_file_stem(name) {
+        return Err(MotionError::invalid(
+            "--name",
+            format!("\"{name}\" is not a file name: give 1–{} letters, digits, `_`, `-`, `.` or `+`, not starting with `.` (no `/`: the files go to --out)", crate::files::MAX_STEM_LEN),
+        ));
+    }
     let set = synthesize_set(req)?;
     let periods = default_periods();
     let mut files = Vec::new();

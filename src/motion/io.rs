@@ -29,10 +29,6 @@ pub fn write_two_column(path: &Path, header: &[String], t0: f64, dt: f64, accel_
     if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(d).map_err(|source| MotionError::Write { path: d.to_path_buf(), source })?;
     }
-    let tmp = path.with_extension(format!("tmp-{}", std::process::id()));
-    std::fs::write(&tmp, text).map_err(|source| MotionError::Write { path: tmp.clone(), source })?;
-    std::fs::rename(&tmp, path).map_err(|source| {
-        let _ = std::fs::remove_file(&tmp);
-        MotionError::Write { path: path.to_path_buf(), source }
-    })
+    // whole, and never over a device, fifo or symlink (`--out /dev/null`, issue 34)
+    crate::files::write_whole(path, text.as_bytes()).map_err(|(path, message)| MotionError::Write { path, source: std::io::Error::other(message) })
 }

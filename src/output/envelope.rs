@@ -370,6 +370,7 @@ mod tests {
             min_principal: vec![0.0; 3],
             max_tension: Extreme::default(),
             max_compression: Extreme::default(),
+            corners: vec![],
             areas: vec![1.0, 2.0, 3.0],
         };
         let got: Vec<f64> = TENSION_THRESHOLDS.iter().map(|&t| f.area_above(t)).collect();

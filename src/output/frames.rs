@@ -23,10 +23,11 @@ impl FrameWriter {
     pub fn create(out_dir: &Path, name: &str, model: &Model) -> Result<FrameWriter, OutputError> {
         let dir = out_dir.join("frames");
         std::fs::create_dir_all(&dir).map_err(|e| OutputError::write(&dir, e))?;
+        let stem = crate::files::file_stem(name);
         Ok(FrameWriter {
             dir,
-            name: name.to_string(),
-            series: PvdSeries::new(out_dir.join(format!("{name}.pvd"))),
+            series: PvdSeries::new(out_dir.join(format!("{stem}.pvd"))),
+            name: stem,
             blocks: model.element_blocks(),
             stress: Vec::new(),
         })

@@ -35,14 +35,18 @@ pub struct CsvLines {
     path: PathBuf,
     file: std::fs::File,
     buf: String,
+    /// Bytes of whole lines in the file (the header and the rows written).
+    len: u64,
 }
 
 impl CsvLines {
     /// Create `path` with its header line.
     pub fn create(path: PathBuf, header: &str) -> Result<CsvLines, OutputError> {
+        // a fifo would block the open, a device or symlink would be written through
+        crate::files::check_regular_target(&path).map_err(|m| OutputError::write(&path, m))?;
         let mut file = std::fs::File::create(&path).map_err(|e| OutputError::write(&path, e))?;
         writeln!(file, "{header}").map_err(|e| OutputError::write(&path, e))?;
-        Ok(CsvLines { path, file, buf: String::new() })
+        Ok(CsvLines { path, file, buf: String::new(), len: header.len() as u64 + 1 })
     }
 
     /// The pending rows; append whole lines ending in `\n`.
@@ -50,11 +54,19 @@ impl CsvLines {
         &mut self.buf
     }
 
-    /// Write the pending rows.
+    /// Write the pending rows. If the write fails part-way (a full disk), the file is cut back
+    /// to its last whole line, so it never ends mid-row (issue 34), and the rows are dropped.
     pub fn flush(&mut self) -> Result<(), OutputError> {
         if !self.buf.is_empty() {
-            self.file.write_all(self.buf.as_bytes()).map_err(|e| OutputError::write(&self.path, e))?;
+            let written = self.file.write_all(self.buf.as_bytes());
+            let n = self.buf.len() as u64;
             self.buf.clear();
+            if let Err(e) = written {
+                let _ = self.file.set_len(self.len);
+                let _ = std::io::Seek::seek(&mut self.file, std::io::SeekFrom::Start(self.len));
+                return Err(OutputError::write(&self.path, e));
+            }
+            self.len += n;
         }
         Ok(())
     }
@@ -80,7 +92,7 @@ impl HistoryWriter {
         std::fs::create_dir_all(dir).map_err(|e| OutputError::write(dir, e))?;
         let mut files = Vec::new();
         for m in monitors {
-            files.push(CsvLines::create(dir.join(format!("{}.csv", m.name)), MONITOR_HEADER)?);
+            files.push(CsvLines::create(dir.join(format!("{}.csv", crate::files::file_stem(&m.name))), MONITOR_HEADER)?);
         }
         if !monitors.is_empty() {
             let p = dir.join("monitors.json");

@@ -151,8 +151,9 @@ impl JointWriter {
         let mut csv = Vec::new();
         let mut peaks = Vec::new();
         for j in joints {
-            series.push(PvdSeries::new(dir.join(format!("{}.pvd", j.tag.name))));
-            csv.push(CsvLines::create(hdir.join(format!("joint_{}.csv", j.tag.name)), JOINT_HEADER)?);
+            let stem = crate::files::file_stem(&j.tag.name);
+            series.push(PvdSeries::new(dir.join(format!("{stem}.pvd"))));
+            csv.push(CsvLines::create(hdir.join(format!("joint_{stem}.csv")), JOINT_HEADER)?);
             peaks.push(JointPeaks {
                 name: j.tag.name.clone(),
                 method: format!("{:?}", j.method),
@@ -167,7 +168,7 @@ impl JointWriter {
         let mut fcsv = Vec::new();
         if forces {
             for j in joints {
-                fcsv.push((CsvLines::create(hdir.join(format!("joint_{}_forces.csv", j.tag.name)), JOINT_FORCES_HEADER)?, vec![false; j.tag.n_slave()]));
+                fcsv.push((CsvLines::create(hdir.join(format!("joint_{}_forces.csv", crate::files::file_stem(&j.tag.name))), JOINT_FORCES_HEADER)?, vec![false; j.tag.n_slave()]));
             }
         }
         let anchor = joints.iter().map(|j| vec![[f64::NAN; 3]; j.tag.n_slave()]).collect();
@@ -175,8 +176,12 @@ impl JointWriter {
     }
 
     /// Per slave node of joint `k`: its `lost_travel` [m] (0 when in contact) at displacement
-    /// `u`, moving the anchors of the nodes in contact.
-    fn lost_travel(&mut self, k: usize, j: &ContactJoint, r: &JointRecord, u: &[f64]) -> Vec<f64> {
+    /// `u`, and its penetration estimated against the master surface it left: the travel since
+    /// it was last in contact along its slave normal n (into the master), max(0, n · Δ) [m],
+    /// the gap then taken as closed. A lost node has no projection, so its penetration was not
+    /// measured at all: a block sank 3.73 m with a summary "max penetration 6.6e-24 m" (issue
+    /// 34). Moves the anchors of the nodes in contact.
+    fn lost_travel(&mut self, k: usize, j: &ContactJoint, r: &JointRecord, u: &[f64]) -> Vec<(f64, f64)> {
         let anchor = &mut self.anchor[k];
         (0..r.pairs.len())
             .map(|i| {
@@ -187,9 +192,11 @@ impl JointWriter {
                 }
                 if is_lost(&r.pairs[i]) {
                     let a = anchor[i];
-                    ((rel[0] - a[0]).powi(2) + (rel[1] - a[1]).powi(2) + (rel[2] - a[2]).powi(2)).sqrt()
+                    let d = [rel[0] - a[0], rel[1] - a[1], rel[2] - a[2]];
+                    let n = j.frames[i][0];
+                    ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]).max(0.0))
                 } else {
-                    0.0
+                    (0.0, 0.0)
                 }
             })
             .collect()
@@ -202,11 +209,12 @@ impl JointWriter {
             let r = &*searched_view(self.unsearched, j, r);
             let travel = self.lost_travel(k, j, r, u);
             let lost = r.pairs.iter().filter(|p| is_lost(p)).count();
-            let ml = travel.iter().copied().fold(0.0f64, f64::max);
+            let ml = travel.iter().map(|t| t.0).fold(0.0f64, f64::max);
             let mut mo = 0.0f64;
             let mut ms = 0.0f64;
             let mut md = 0.0f64;
-            let mut mp = 0.0f64;
+            // lost nodes: penetration against the master surface they left (see `lost_travel`)
+            let mut mp = travel.iter().map(|t| t.1).fold(0.0f64, f64::max);
             let mut fn_ = 0.0;
             let mut ft = 0.0;
             for p in &r.pairs {
@@ -261,7 +269,7 @@ impl JointWriter {
         }
         for (k, (j, r)) in joints.iter().zip(&state.joints).enumerate() {
             let r = &*searched_view(self.unsearched, j, r);
-            let travel = self.lost_travel(k, j, r, u);
+            let travel: Vec<f64> = self.lost_travel(k, j, r, u).into_iter().map(|t| t.0).collect();
             let surf = &j.tag.slave;
             let np = surf.nodes.len();
             let mut disp = Vec::with_capacity(3 * np);
@@ -288,7 +296,7 @@ impl JointWriter {
             let cells: Vec<(CellKind, &[u32])> = surf.faces.iter().map(|f| (f.kind, f.local_nodes())).collect();
             let grid = Grid { points: &surf.points, cells };
             let idx = self.series[k].len();
-            let path = self.dir.join(format!("{}_{idx:05}.vtu", j.tag.name));
+            let path = self.dir.join(format!("{}_{idx:05}.vtu", crate::files::file_stem(&j.tag.name)));
             write_vtu_labelled(
                 &path,
                 &grid,

@@ -68,26 +68,95 @@ pub const LOST_WARN_FRACTION: f64 = 0.01;
 /// 1.5 g) reach; above it the contact forces of those steps are not converged.
 pub const GS_WARN_FACTOR: f64 = 10.0;
 
+/// A joint whose largest penetration (lost nodes included, measured against the master surface
+/// they left) exceeds this fraction of its slave face size gets a warning: 0.1. A contact that
+/// works keeps penetration at round-off (NTS) or at the penalty's F/k (a few µm on the incline
+/// at k = 1e10 Pa/m); a tenth of an element is a block sinking into its base.
+pub const PENETRATION_WARN_FRACTION: f64 = 0.1;
+
 /// An NTN joint whose largest slave-to-O distance exceeds this fraction of the slave face size
 /// gets a warning: 0.1. NTN pairs each slave node with one master point O fixed at tagging; on a
 /// non-conforming mesh the offset is a lever arm of the contact force (39–135 % stress error on a
 /// patch test): use NTS there.
 pub const NTN_WARN_FRACTION: f64 = 0.1;
 
-/// Set by Ctrl-C / SIGTERM / SIGHUP once [`install_interrupt_handler`] ran.
-static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Make Ctrl-C, SIGTERM and SIGHUP end a run cleanly: the first prints one line and the run
-/// stops at its next output (row and frames written, `summary.json` marked `interrupted`); a
-/// second quits at once (exit status 130). For the CLI; call once.
+/// Make Ctrl-C, SIGTERM and SIGHUP end a run cleanly ([`crate::interrupt`]): during the time
+/// loop the run stops at its next output (row and frames written, `summary.json` marked
+/// `interrupted`); before it, at the end of the phase it is in; a second signal quits at once
+/// (exit status 130). For the CLI; call once.
 pub fn install_interrupt_handler() -> Result<(), String> {
-    ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, std::sync::atomic::Ordering::SeqCst) {
-            std::process::exit(130);
+    crate::interrupt::install_handler()
+}
+
+/// The steps between two volume frames for `spec` at step `dt` over `n_steps` steps.
+pub fn frame_stride(spec: &crate::scene::OutputSpec, dt: f64, n_steps: usize) -> usize {
+    match (spec.frame_stride, spec.frame_interval) {
+        (Some(k), _) => k,
+        (None, Some(fi)) => ((fi / dt).round() as usize).max(1),
+        (None, None) => (n_steps / 100).max(1),
+    }
+}
+
+/// Most volume frames a run may write: 100 000 (34 GB of the demo wedge's 0.34 MB frames);
+/// `frame_interval` 1e-9 s asked for one every step of a million-step run.
+pub const MAX_FRAMES: usize = 100_000;
+/// Most history rows a run may write per monitor and joint: 10⁸ (20 GB a monitor at 200 B a
+/// row).
+pub const MAX_HISTORY_ROWS: usize = 100_000_000;
+
+/// The checks of a run's outputs that need the model and the step but write nothing, made
+/// before the static state (`pipeline`) and again when the recorder is created: every output
+/// file name unique within the run (a monitor `joint_J` and a joint `J` both wrote
+/// `histories/joint_J.csv`, issue 34), no planned file an existing non-regular file (device,
+/// fifo, symlink), the frame and history-row counts within [`MAX_FRAMES`] and
+/// [`MAX_HISTORY_ROWS`], and the envelope's face groups valid (it was checked only after the
+/// other outputs were written).
+pub fn check_outputs(sim: &Simulation<'_>, out_dir: &Path) -> Result<(), Error> {
+    let p: &Problem = sim.problem;
+    let (model, scene) = (&p.model, &p.scene);
+    let invalid = |m: String| -> Error { ModelError::Invalid(m).into() };
+    let mut files: std::collections::BTreeMap<String, String> = std::collections::BTreeMap::new();
+    let mut claim = |file: String, owner: String| -> Result<(), Error> {
+        if let Some(other) = files.get(&file) {
+            return Err(invalid(format!("output file {file} would be written by both {other} and {owner}: rename one of them (output file names must be unique within a run)")));
         }
-        eprintln!("interrupted: finishing the current output and writing summary.json (press Ctrl-C again to quit at once)");
-    })
-    .map_err(|e| format!("cannot install the Ctrl-C handler: {e}"))
+        files.insert(file, owner);
+        Ok(())
+    };
+    let stem = crate::files::file_stem;
+    claim("summary.json".into(), "the run summary".into())?;
+    if scene.output.frames {
+        claim(format!("{}.pvd", stem(scene.name())), format!("the scene \"{}\"", scene.name()))?;
+    }
+    for m in &scene.output.monitor {
+        claim(format!("histories/{}.csv", stem(&m.name)), format!("monitor \"{}\"", m.name))?;
+    }
+    for j in &p.joints {
+        let (s, who) = (stem(&j.tag.name), format!("joint \"{}\"", j.tag.name));
+        claim(format!("histories/joint_{s}.csv"), who.clone())?;
+        if scene.output.joint_forces {
+            claim(format!("histories/joint_{s}_forces.csv"), who.clone())?;
+        }
+        if scene.output.frames {
+            claim(format!("joints/{s}.pvd"), who)?;
+        }
+    }
+    for f in files.keys() {
+        crate::files::check_regular_target(&out_dir.join(f)).map_err(|m| invalid(format!("output: {m}")))?;
+    }
+    let (dt, n) = (sim.dt(), sim.n_steps());
+    let frames = if scene.output.frames { n / frame_stride(&scene.output, dt, n).max(1) + 2 } else { 0 };
+    if frames > MAX_FRAMES {
+        return Err(invalid(format!("output: {frames} volume frames ({n} steps of {dt:.4e} s), above the limit of {MAX_FRAMES}: raise output.frame_interval or frame_stride, or set \"frames\": false")));
+    }
+    let rows = n / history_stride(&scene.output, dt, scene.time.duration) + 2;
+    if rows > MAX_HISTORY_ROWS {
+        return Err(invalid(format!("output: {rows} history rows ({n} steps of {dt:.4e} s), above the limit of {MAX_HISTORY_ROWS}: raise output.history_interval or history_stride")));
+    }
+    if let Some(spec) = &scene.output.envelope {
+        EnvelopeWriter::create(model, spec)?;
+    }
+    Ok(())
 }
 
 /// The steps between two history rows for `spec` at step `dt` over `duration` [s].
@@ -186,6 +255,7 @@ impl Recorder {
         let p: &Problem = sim.problem;
         let (model, scene) = (&p.model, &p.scene);
         std::fs::create_dir_all(out_dir).map_err(|e| OutputError::write(out_dir, e))?;
+        check_outputs(sim, out_dir)?;
         let monitors = snap_monitors(model, scene)?;
         let history = HistoryWriter::create(&out_dir.join("histories"), &monitors)?;
         let frames = if scene.output.frames { Some(FrameWriter::create(out_dir, scene.name(), model)?) } else { None };
@@ -198,11 +268,7 @@ impl Recorder {
         let envelope = match &scene.output.envelope { Some(spec) => Some(EnvelopeWriter::create(model, spec)?), None => None };
         let dt = sim.dt();
         let n_steps = sim.n_steps();
-        let frame_stride = match (scene.output.frame_stride, scene.output.frame_interval) {
-            (Some(k), _) => k,
-            (None, Some(fi)) => ((fi / dt).round() as usize).max(1),
-            (None, None) => (n_steps / 100).max(1),
-        };
+        let frame_stride = frame_stride(&scene.output, dt, n_steps);
         let bar = if progress && std::io::stderr().is_terminal() {
             let b = indicatif::ProgressBar::new(n_steps as u64);
             b.set_style(
@@ -324,6 +390,12 @@ impl Recorder {
                     pk.name, inside, 100.0 * lost, 100.0 * LOST_WARN_FRACTION, pk.max_lost_travel
                 ));
             }
+            if pk.max_penetration > PENETRATION_WARN_FRACTION * pk.face_size {
+                w.push(format!(
+                    "joint {}: the largest penetration is {:.3e} m, {:.0} % of the slave face size {:.3e} m (above {:.0} %; lost nodes are measured against the master surface they left): the joint does not hold its blocks apart",
+                    pk.name, pk.max_penetration, 100.0 * pk.max_penetration / pk.face_size, pk.face_size, 100.0 * PENETRATION_WARN_FRACTION
+                ));
+            }
             if pk.unconverged_steps > 0 && pk.gs_tolerance > 0.0 && pk.max_gs_residual > GS_WARN_FACTOR * pk.gs_tolerance {
                 // the joints' pairs are swept together, so joints sharing the sweeps report the
                 // same numbers: one warning for them all (a dam's 28 joints gave 28 equal lines)
@@ -431,7 +503,7 @@ impl Observer for Recorder {
         let p = sim.problem;
         let state = &sim.state;
         let dt = sim.dt();
-        if self.stop.is_none() && k < last && INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst) {
+        if self.stop.is_none() && k < last && crate::interrupt::interrupted() {
             self.stop = Some(k + 1);
         }
         let last = self.stop.map_or(last, |s| s.min(last));

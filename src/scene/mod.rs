@@ -7,6 +7,9 @@
 pub mod foundation;
 pub mod patterns;
 pub mod reservoir;
+mod validate;
+
+pub use validate::*;
 
 use crate::error::SceneError;
 use serde::{Deserialize, Serialize};
@@ -75,8 +78,8 @@ pub struct ReservoirScene {
     /// at the dam, Kuo's generalised Westergaard as usually applied) or `"local"` (the depth of
     /// the node's own section, above the nearest point of the face's foot: smaller on an arch
     /// dam's banks; docs/dam.md, "Modes").
-    #[serde(default = "default_added_mass_depth")]
-    pub added_mass_depth: String,
+    #[serde(default)]
+    pub added_mass_depth: AddedMassDepth,
     /// The hydrodynamic model (`reservoir::ReservoirModel`): `"westergaard"` (default, the
     /// seed's), `"westergaard_local"`, `"fe_incompressible"` (needs `fluid`). docs/scenes.md.
     #[serde(default)]
@@ -86,8 +89,15 @@ pub struct ReservoirScene {
     pub fluid: Option<reservoir::FluidScene>,
 }
 
-fn default_added_mass_depth() -> String {
-    "reservoir".into()
+/// `reservoir.added_mass_depth`: which depth H enters the added mass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AddedMassDepth {
+    /// The depth at the dam, z_w − z_b (the default).
+    #[default]
+    Reservoir,
+    /// The depth of the node's own section.
+    Local,
 }
 
 fn default_rho_w() -> f64 {
@@ -246,8 +256,8 @@ pub struct BaseSynth {
     /// Seed of the random phases (ChaCha8): the same seed gives the same record.
     pub seed: u64,
     /// "h1", "h2" (horizontal) or "v" (vertical, 2/3 of the target and PGA). Default "h1".
-    #[serde(default = "default_component")]
-    pub component: String,
+    #[serde(default)]
+    pub component: SynthComponent,
     /// Record length [s]. Default 20 (the default envelope's 2 + 8 + 10 s).
     #[serde(default = "default_synth_duration")]
     pub duration: f64,
@@ -261,8 +271,39 @@ pub struct BaseSynth {
     pub pga: Option<f64>,
 }
 
-fn default_component() -> String {
-    "h1".into()
+/// `loads.base[].synth.component`: which component of the seed's three-component set.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SynthComponent {
+    /// First horizontal component (the default).
+    #[default]
+    H1,
+    /// Second horizontal component.
+    H2,
+    /// Vertical component (2/3 of the target and PGA).
+    V,
+}
+
+impl SynthComponent {
+    /// The scene's spelling (`"h1"`, `"h2"`, `"v"`), also the name in `record synth`'s files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SynthComponent::H1 => "h1",
+            SynthComponent::H2 => "h2",
+            SynthComponent::V => "v",
+        }
+    }
+
+    /// Index in the set (`motion::synth::COMPONENT_NAMES`).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl std::fmt::Display for SynthComponent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }
 fn default_synth_duration() -> f64 {
     20.0
@@ -460,8 +501,8 @@ fn default_energy_tol() -> f64 {
 pub struct EquilibriumSpec {
     /// "relaxation" (default when gravity is on): bring gravity to equilibrium before the
     /// dynamic stage; "none": gravity acts from t = 0 in the dynamic stage (sliding from rest).
-    #[serde(default = "relaxation")]
-    pub method: String,
+    #[serde(default)]
+    pub method: EquilibriumMethod,
     /// Relative residual ‖F − K u‖/‖F‖ at which relaxation stops. Default 1e-6.
     #[serde(default = "default_eq_tol")]
     pub tolerance: f64,
@@ -479,27 +520,61 @@ pub struct EquilibriumSpec {
     /// loading path alone (on the seed wedge 80 % of the pairs of joint A lose their cohesion
     /// that way, leaving the friction-only FS 1.11 instead of 1.85 before any shaking).
     /// "brittle": the joints' own law applies during relaxation too.
-    #[serde(default = "default_joint_bonds")]
-    pub joint_bonds: String,
+    #[serde(default)]
+    pub joint_bonds: JointBonds,
     /// How the static loads meet the joints (module `construction`): "simultaneous" (default:
     /// gravity and the reservoir at once, the joints in contact with their gaps as meshed),
     /// "grouted" (the same, the joints grouted first: zero gap where their sides are at the
     /// start), "construction" (self-weight with the joints that are not `tied` open, then
     /// grouting at the deformed state, then the reservoir with the joints active).
-    #[serde(default = "default_sequence")]
-    pub sequence: String,
+    #[serde(default)]
+    pub sequence: StaticSequence,
 }
 
-fn default_sequence() -> String {
-    "simultaneous".into()
+/// `equilibrium.method`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EquilibriumMethod {
+    /// Dynamic relaxation of the static loads before the dynamic stage (the default).
+    #[default]
+    Relaxation,
+    /// No static stage: gravity acts from t = 0 in the dynamic stage.
+    None,
 }
 
-fn default_joint_bonds() -> String {
-    "kept".into()
+/// `equilibrium.joint_bonds`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JointBonds {
+    /// Every joint keeps its bonds during relaxation (the default).
+    #[default]
+    Kept,
+    /// The joints' own law applies during relaxation too.
+    Brittle,
 }
 
-fn relaxation() -> String {
-    "relaxation".into()
+/// `equilibrium.sequence`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum StaticSequence {
+    /// Static loads at once, joints in contact with their gaps as meshed (the default).
+    #[default]
+    Simultaneous,
+    /// The same after grouting the joints on the initial configuration.
+    Grouted,
+    /// Self-weight with open joints, grouting, then the reservoir with the joints active.
+    Construction,
+}
+
+impl StaticSequence {
+    /// The scene's spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StaticSequence::Simultaneous => "simultaneous",
+            StaticSequence::Grouted => "grouted",
+            StaticSequence::Construction => "construction",
+        }
+    }
 }
 fn default_eq_tol() -> f64 {
     1e-6
@@ -513,7 +588,14 @@ fn default_eq_steps() -> usize {
 
 impl Default for EquilibriumSpec {
     fn default() -> Self {
-        EquilibriumSpec { method: relaxation(), tolerance: default_eq_tol(), max_residual: default_eq_max_res(), max_steps: default_eq_steps(), joint_bonds: default_joint_bonds(), sequence: default_sequence() }
+        EquilibriumSpec {
+            method: EquilibriumMethod::default(),
+            tolerance: default_eq_tol(),
+            max_residual: default_eq_max_res(),
+            max_steps: default_eq_steps(),
+            joint_bonds: JointBonds::default(),
+            sequence: StaticSequence::default(),
+        }
     }
 }
 
@@ -749,52 +831,12 @@ impl JointSceneSpec {
     }
 }
 
-/// Young's modulus accepted [Pa]: 1 kPa (a very soft soil) to 10 TPa (ten times diamond). Outside
-/// this the input is in the wrong unit, and the stable step becomes absurd (E 1e307 Pa would
-/// take ~10¹⁵⁰ steps a second; E 1e-300 Pa no step at all).
-pub const E_RANGE: (f64, f64) = (1e3, 1e13);
-/// Density accepted when positive [kg/m³]: 1 (air) to 10⁵ (five times osmium). 0 is allowed
-/// (a block without mass). Below, the stable step is NaN or absurd (rho 1e-300 gave dt = NaN).
-pub const RHO_RANGE: (f64, f64) = (1.0, 1e5);
-/// Largest traction component accepted [Pa] (10⁴ GPa) and nodal force [N]: beyond these the
-/// run overflows to inf (a 1e300 N force gave inf peaks and `null` in summary.json).
-pub const MAX_TRACTION: f64 = 1e13;
-pub const MAX_FORCE: f64 = 1e15;
 
-/// A load's vector within `max` and its ramp a finite time ≥ 0 [s].
-fn check_load(what: &str, field: &str, v: &[f64; 3], max: f64, unit: &str, ramp: f64) -> Result<(), String> {
-    if v.iter().any(|c| !(c.abs() <= max)) {
-        return Err(format!("{what}: {field} = {v:?} must be finite with components of at most {max:e} {unit}"));
-    }
-    if !(ramp >= 0.0 && ramp.is_finite()) {
-        return Err(format!("{what}: ramp = {ramp} must be a finite time ≥ 0 [s] (0 = step load)"));
-    }
-    Ok(())
-}
-
-/// The file stem of a joint's outputs (`joints/<stem>.pvd`, `tagging/<stem>.vtu`): its name with
-/// every character other than letters, digits, `-`, `_` and `.` replaced by `_`.
-pub fn joint_file_stem(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') { c } else { '_' }).collect()
-}
-
-/// A name that becomes a file name (scene → `<name>.pvd`, monitor → `histories/<name>.csv`):
-/// letters, digits, `_`, `-`, `.`, `:`, `+`, not starting with `.`, 1–100 characters, so that
-/// no name writes outside the output directory or makes a hidden file.
-pub fn check_file_name(field: &str, name: &str) -> Result<(), String> {
-    let ok_char = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+');
-    if name.is_empty() || name.len() > 100 || name.starts_with('.') || !name.chars().all(ok_char) {
-        return Err(format!(
-            "{field} \"{name}\" becomes a file name: use 1–100 letters, digits, `_`, `-`, `.` or `+`, not starting with `.` (no `/`, spaces or `..`)"
-        ));
-    }
-    Ok(())
-}
 
 impl Scene {
     /// Read and validate a scene file; relative paths are resolved against its directory.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+        let text = crate::files::read_text_bounded(path, crate::files::MAX_TEXT_INPUT).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
         let mut scene: Scene = serde_json::from_str(&text).map_err(|e| SceneError::Parse {
             path: path.to_path_buf(),
             message: format!("{e} (see docs/scenes.md for the fields)"),
@@ -816,9 +858,8 @@ impl Scene {
         }
         if scene.name.is_none() {
             // From the file name, with the characters a name may not hold replaced by `_`.
-            let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
-            let clean: String = stem.chars().map(|c| if c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | '+') { c } else { '_' }).collect();
-            scene.name = Some(clean.trim_start_matches('.').to_string()).filter(|n| !n.is_empty()).or(Some("scene".into()));
+            let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            scene.name = Some(if stem.is_empty() { "scene".into() } else { crate::files::file_stem(&stem) });
         }
         scene.validate().map_err(|message| SceneError::Invalid { path: path.to_path_buf(), message })?;
         Ok(scene)
@@ -833,228 +874,32 @@ impl Scene {
     pub fn output_dir(&self) -> PathBuf {
         self.output.dir.clone().unwrap_or_else(|| PathBuf::from("out").join(self.name()))
     }
+}
 
-    /// Checks that need no mesh (group names are checked against the mesh when the model is built).
-    pub fn validate(&self) -> Result<(), String> {
-        match (&self.geometry.geo, &self.geometry.msh) {
-            (Some(_), Some(_)) => return Err("geometry: give either `geo` or `msh`, not both".into()),
-            (None, None) => return Err("geometry: give `geo` (a Gmsh script) or `msh` (a mesh file)".into()),
-            _ => {}
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn knob_enums_keep_their_json_spelling_and_defaults() {
+        // The string knobs became enums (issue 27): the JSON spelling and the defaults must be
+        // those of the strings they replace, so every existing scene reads the same.
+        let eq: EquilibriumSpec = serde_json::from_str(r#"{"method": "none", "joint_bonds": "brittle", "sequence": "construction"}"#).unwrap();
+        assert_eq!((eq.method, eq.joint_bonds, eq.sequence), (EquilibriumMethod::None, JointBonds::Brittle, StaticSequence::Construction));
+        let d = EquilibriumSpec::default();
+        assert_eq!((d.method, d.joint_bonds, d.sequence), (EquilibriumMethod::Relaxation, JointBonds::Kept, StaticSequence::Simultaneous));
+        let from_empty: EquilibriumSpec = serde_json::from_str("{}").unwrap();
+        assert_eq!((from_empty.method, from_empty.joint_bonds, from_empty.sequence), (d.method, d.joint_bonds, d.sequence));
+        for (text, c) in [("h1", SynthComponent::H1), ("h2", SynthComponent::H2), ("v", SynthComponent::V)] {
+            assert_eq!(serde_json::from_str::<SynthComponent>(&format!("\"{text}\"")).unwrap(), c);
+            assert_eq!(c.as_str(), text);
+            assert_eq!(crate::motion::synth::COMPONENT_NAMES[c.index()], text);
         }
-        check_file_name("name", self.name())?;
-        if self.geometry.msh.is_some() && !self.geometry.set.is_empty() {
-            return Err("geometry.set: `-setnumber` parameters apply to a `.geo`, but this scene reads a ready `msh`. Remove `set`, or mesh the `.geo` instead.".into());
+        assert_eq!(serde_json::from_str::<AddedMassDepth>("\"local\"").unwrap(), AddedMassDepth::Local);
+        assert_eq!(AddedMassDepth::default(), AddedMassDepth::Reservoir);
+        assert!(serde_json::from_str::<StaticSequence>("\"sequential\"").unwrap_err().to_string().contains("simultaneous"));
+        for s in [StaticSequence::Simultaneous, StaticSequence::Grouted, StaticSequence::Construction] {
+            assert_eq!(serde_json::to_string(&s).unwrap(), format!("\"{}\"", s.as_str()));
         }
-        if self.materials.is_empty() {
-            return Err("materials: at least one material group is needed".into());
-        }
-        for m in &self.materials {
-            if !(m.e > 0.0 && m.e.is_finite()) {
-                return Err(format!("material \"{}\": E = {} must be positive [Pa]", m.group, m.e));
-            }
-            if !(E_RANGE.0..=E_RANGE.1).contains(&m.e) {
-                return Err(format!(
-                    "material \"{}\": E = {:e} Pa is outside {:e}–{:e} Pa (soft soil to diamond). Young's modulus is in Pa: 30 GPa is 30e9.",
-                    m.group, m.e, E_RANGE.0, E_RANGE.1
-                ));
-            }
-            if !(0.0..0.5).contains(&m.nu) {
-                return Err(format!("material \"{}\": nu = {} must be in [0, 0.5)", m.group, m.nu));
-            }
-            if !(m.rho >= 0.0 && m.rho.is_finite()) {
-                return Err(format!("material \"{}\": rho = {} must be ≥ 0 [kg/m³]", m.group, m.rho));
-            }
-            if m.rho == 0.0 && !m.massless {
-                return Err(format!("material \"{}\": rho = 0; a block without mass is declared with `\"massless\": true` (a massless foundation, condensed statically), else give its density", m.group));
-            }
-            if m.rho > 0.0 && !(RHO_RANGE.0..=RHO_RANGE.1).contains(&m.rho) {
-                return Err(format!(
-                    "material \"{}\": rho = {:e} kg/m³ is outside {:e}–{:e} kg/m³. Density is in kg/m³ (rock about 2000–3000).",
-                    m.group, m.rho, RHO_RANGE.0, RHO_RANGE.1
-                ));
-            }
-        }
-        for b in &self.boundary {
-            for c in &b.fix {
-                if !matches!(c.as_str(), "x" | "y" | "z") {
-                    return Err(format!("boundary \"{}\": component \"{c}\" must be \"x\", \"y\" or \"z\"", b.group));
-                }
-            }
-        }
-        self.foundation.as_ref().map_or(Ok(()), |f| f.validate(&self.materials))?;
-        if self.loads.base.len() > 3 {
-            return Err(format!("loads.base: {} records given, at most 3", self.loads.base.len()));
-        }
-        for (k, b) in self.loads.base.iter().enumerate() {
-            let l = b.label(k);
-            match (&b.record, &b.synth) {
-                (Some(_), Some(_)) => return Err(format!("{l}: give `record` (a file) or `synth` (a generated record), not both")),
-                (None, None) => return Err(format!("{l}: give `record` (a two-column or .AT2 file) or `synth` (a target spectrum and a seed)")),
-                _ => {}
-            }
-            if let Some(s) = &b.synth {
-                if !crate::motion::synth::COMPONENT_NAMES.contains(&s.component.as_str()) {
-                    return Err(format!("{l}: synth.component = \"{}\" must be \"h1\", \"h2\" or \"v\"", s.component));
-                }
-                if s.pga.is_none() && b.pga.is_none() {
-                    return Err(format!("{l}: a synth entry needs the set's design PGA: give the entry's `pga` [g] (or `synth.pga`, the horizontal PGA the spectrum is drawn for, with `scale`)"));
-                }
-            }
-            b.baseline.resolve().map_err(|e| format!("{l}: {e}"))?;
-            if b.scale.is_some() && b.pga.is_some() {
-                return Err(format!("{l}: give `scale` or `pga`, not both"));
-            }
-            let n = (b.direction[0].powi(2) + b.direction[1].powi(2) + b.direction[2].powi(2)).sqrt();
-            if !(n > 0.0 && n.is_finite()) {
-                return Err(format!("{l}: direction must be a non-zero vector"));
-            }
-            if let Some(pga) = b.pga {
-                if !(pga > 0.0 && pga.is_finite()) {
-                    return Err(format!("{l}: pga = {pga} must be positive [g]. To reverse the record's polarity, reverse its `direction`."));
-                }
-            }
-            if let Some(sc) = b.scale {
-                if !(sc > 0.0 && sc.is_finite()) {
-                    return Err(format!("{l}: scale = {sc} must be positive. To reverse the record's polarity, reverse its `direction`."));
-                }
-            }
-        }
-        if let Some(g) = &self.loads.gravity {
-            let n = (g.direction[0].powi(2) + g.direction[1].powi(2) + g.direction[2].powi(2)).sqrt();
-            if !(n > 0.0 && n.is_finite()) {
-                return Err(format!("loads.gravity.direction = {:?} must be a non-zero vector (default [0, 0, -1])", g.direction));
-            }
-            if !(g.g > 0.0 && g.g.is_finite()) {
-                return Err(format!("loads.gravity.g = {} must be positive [m/s²] (default 9.81); the direction gives the sense", g.g));
-            }
-        }
-        for (k, t) in self.loads.traction.iter().enumerate() {
-            check_load(&format!("loads.traction[{k}] (group \"{}\")", t.group), "traction", &t.traction, MAX_TRACTION, "Pa", t.ramp)?;
-        }
-        for (k, f) in self.loads.nodal.iter().enumerate() {
-            check_load(&format!("loads.nodal[{k}]"), "force", &f.force, MAX_FORCE, "N", f.ramp)?;
-        }
-        if !(self.time.duration >= 0.0 && self.time.duration.is_finite()) {
-            return Err(format!("time.duration = {} must be ≥ 0 [s]", self.time.duration));
-        }
-        if let Some(dt) = self.time.dt {
-            if !(dt > 0.0 && dt.is_finite()) {
-                return Err(format!("time.dt = {dt} must be positive [s]"));
-            }
-        }
-        if let Some(c) = self.time.courant {
-            if !(c > 0.0 && c <= 1.0) {
-                return Err(format!("time.courant = {c} must be in (0, 1]"));
-            }
-        }
-        if let Some(ms) = &self.time.mass_scaling {
-            if !(ms.target_dt > 0.0 && ms.target_dt.is_finite()) {
-                return Err(format!("time.mass_scaling.target_dt = {} must be positive and finite [s] (the step the scaled elements should allow; remove `mass_scaling` to run without)", ms.target_dt));
-            }
-        }
-        if !(self.time.energy_tolerance > 0.0 && self.time.energy_tolerance.is_finite()) {
-            return Err(format!("time.energy_tolerance = {} must be positive (default 0.05)", self.time.energy_tolerance));
-        }
-        if !(self.equilibrium.tolerance > 0.0 && self.equilibrium.tolerance.is_finite()) {
-            return Err(format!("equilibrium.tolerance = {} must be positive (default 1e-6)", self.equilibrium.tolerance));
-        }
-        if !(self.equilibrium.max_residual > 0.0 && self.equilibrium.max_residual.is_finite()) {
-            return Err(format!("equilibrium.max_residual = {} must be positive (default 1e-3)", self.equilibrium.max_residual));
-        }
-        if self.time.dt.is_some() && self.time.courant.is_some() {
-            return Err("time: give `dt` or `courant`, not both".into());
-        }
-        if !matches!(self.equilibrium.joint_bonds.as_str(), "kept" | "brittle") {
-            return Err(format!("equilibrium.joint_bonds \"{}\" is not \"kept\" or \"brittle\"", self.equilibrium.joint_bonds));
-        }
-        if !matches!(self.equilibrium.sequence.as_str(), "simultaneous" | "grouted" | "construction") {
-            return Err(format!("equilibrium.sequence \"{}\" is not \"simultaneous\", \"grouted\" or \"construction\"", self.equilibrium.sequence));
-        }
-        if !matches!(self.equilibrium.method.as_str(), "relaxation" | "none") {
-            return Err(format!("equilibrium.method \"{}\" is not \"relaxation\" or \"none\"", self.equilibrium.method));
-        }
-        if let Some(e) = &self.output.envelope {
-            if e.faces.is_empty() || e.stride == 0 {
-                return Err("output.envelope: give at least one face group in `faces` and a `stride` ≥ 1 [steps]".into());
-            }
-        }
-        if self.output.frame_stride.is_some() && self.output.frame_interval.is_some() {
-            return Err("output: give `frame_stride` or `frame_interval`, not both".into());
-        }
-        if let Some(fi) = self.output.frame_interval {
-            if !(fi > 0.0 && fi.is_finite()) {
-                return Err(format!("output.frame_interval = {fi} must be positive [s]"));
-            }
-        }
-        if self.output.history_stride.is_some() && self.output.history_interval.is_some() {
-            return Err("output: give `history_stride` or `history_interval`, not both".into());
-        }
-        if let Some(hi) = self.output.history_interval {
-            if !(hi.is_finite() && hi > 0.0) {
-                return Err(format!("output.history_interval = {hi} must be a positive time [s]"));
-            }
-        }
-        if self.output.frame_stride == Some(0) {
-            return Err("output.frame_stride must be at least 1".into());
-        }
-        for j in &self.joints {
-            if j.mu.is_some() && j.phi.is_some() {
-                return Err(format!("joint \"{}\": give `mu` or `phi`, not both", j.name));
-            }
-        }
-        let mut monitors = std::collections::BTreeSet::new();
-        for m in &self.output.monitor {
-            check_file_name("output.monitor name", &m.name)?;
-            if !monitors.insert(m.name.as_str()) {
-                return Err(format!("output.monitor: two monitors are named \"{}\" (each writes histories/{}.csv): give each its own name", m.name, m.name));
-            }
-        }
-        let mut joint_stems: BTreeMap<String, &str> = BTreeMap::new();
-        let mut joint_sides = std::collections::BTreeMap::new();
-        for j in &self.joints {
-            if j.name.is_empty() {
-                return Err("joints: a joint has an empty `name`".into());
-            }
-            let stem = joint_file_stem(&j.name);
-            if let Some(other) = joint_stems.get(&stem) {
-                return Err(format!("joint \"{}\": its output file name \"{stem}.vtu\" is also that of joint \"{other}\"; give the joints distinct names", j.name));
-            }
-            joint_stems.insert(stem, j.name.as_str());
-            let key = if j.master <= j.slave { (j.master.as_str(), j.slave.as_str()) } else { (j.slave.as_str(), j.master.as_str()) };
-            if let Some(other) = joint_sides.insert(key, j.name.as_str()) {
-                return Err(format!(
-                    "joints \"{other}\" and \"{}\" both join \"{}\" and \"{}\": the contact would be applied twice. Keep one.",
-                    j.name, key.0, key.1
-                ));
-            }
-            if j.master == j.slave {
-                return Err(format!("joint \"{}\": master and slave are the same group \"{}\"", j.name, j.master));
-            }
-        }
-        self.damping.coefficients()?;
-        if let Some(r) = &self.reservoir {
-            if r.faces.is_empty() {
-                return Err("reservoir.faces: name at least one wet face group".into());
-            }
-            if !(r.rho_w > 0.0 && r.rho_w.is_finite()) {
-                return Err(format!("reservoir.rho_w = {} must be positive [kg/m³]", r.rho_w));
-            }
-            if !matches!(r.added_mass_depth.as_str(), "reservoir" | "local") {
-                return Err(format!("reservoir.added_mass_depth \"{}\" is not \"reservoir\" (the depth at the dam) or \"local\" (the depth of the node's section)", r.added_mass_depth));
-            }
-            reservoir::validate(r.model, r.fluid.as_ref(), &r.added_mass_depth)?;
-            if !r.level.is_finite() {
-                return Err("reservoir.level must be a finite height [m]".into());
-            }
-            if let Some(b) = r.bottom {
-                if !(b < r.level) {
-                    return Err(format!("reservoir.bottom = {b} m must be below the pool level {} m", r.level));
-                }
-            }
-        }
-        if !(self.g > 0.0) {
-            return Err(format!("g = {} must be positive [m/s²]", self.g));
-        }
-        Ok(())
     }
 }

@@ -54,7 +54,7 @@ pub struct FluidScene {
 }
 
 /// Checks of the reservoir fields this module owns (called from `Scene::validate`).
-pub fn validate(model: ReservoirModel, fluid: Option<&FluidScene>, added_mass_depth: &str) -> Result<(), String> {
+pub fn validate(model: ReservoirModel, fluid: Option<&FluidScene>, added_mass_depth: super::AddedMassDepth) -> Result<(), String> {
     match (model, fluid) {
         (ReservoirModel::FeIncompressible, None) => {
             return Err("reservoir.model \"fe_incompressible\" needs `reservoir.fluid` (the water's volume, wet, free_surface and far_end groups of the mesh; docs/scenes.md)".into())
@@ -67,8 +67,8 @@ pub fn validate(model: ReservoirModel, fluid: Option<&FluidScene>, added_mass_de
         }
         _ => {}
     }
-    if model == ReservoirModel::FeIncompressible && added_mass_depth != "reservoir" {
-        return Err(format!("reservoir.added_mass_depth \"{added_mass_depth}\" applies to the Westergaard models only; remove it with \"model\": \"fe_incompressible\""));
+    if model == ReservoirModel::FeIncompressible && added_mass_depth != super::AddedMassDepth::Reservoir {
+        return Err(format!("reservoir.added_mass_depth \"local\" applies to the Westergaard models only; remove it with \"model\": \"fe_incompressible\""));
     }
     if let Some(f) = fluid {
         if f.volume.is_empty() {
@@ -99,12 +99,12 @@ mod tests {
 
     #[test]
     fn fe_model_without_a_water_mesh_is_refused_with_the_fix() {
-        let e = validate(ReservoirModel::FeIncompressible, None, "reservoir").unwrap_err();
+        let e = validate(ReservoirModel::FeIncompressible, None, super::super::AddedMassDepth::Reservoir).unwrap_err();
         assert!(e.contains("reservoir.fluid"), "{e}");
         let f = FluidScene { volume: "block:water".into(), wet: vec!["water:dam".into()], free_surface: vec![], far_end: vec![] };
-        let e = validate(ReservoirModel::FeIncompressible, Some(&f), "reservoir").unwrap_err();
+        let e = validate(ReservoirModel::FeIncompressible, Some(&f), super::super::AddedMassDepth::Reservoir).unwrap_err();
         assert!(e.contains("free_surface"), "{e}");
-        let e = validate(ReservoirModel::Westergaard, Some(&f), "reservoir").unwrap_err();
+        let e = validate(ReservoirModel::Westergaard, Some(&f), super::super::AddedMassDepth::Reservoir).unwrap_err();
         assert!(e.contains("fe_incompressible"), "{e}");
     }
 }

@@ -176,7 +176,7 @@ impl Study {
     /// Read and check a study file.
     pub fn load(path: &Path) -> Result<Study, StudyError> {
         let invalid = |message: String| StudyError::Invalid { path: path.to_path_buf(), message };
-        let text = std::fs::read_to_string(path).map_err(|e| StudyError::Io { path: path.to_path_buf(), message: e.to_string() })?;
+        let text = crate::files::read_text_bounded(path, crate::files::MAX_TEXT_INPUT).map_err(|e| StudyError::Io { path: path.to_path_buf(), message: e.to_string() })?;
         let f: StudyFile = serde_json::from_str(&text).map_err(|e| invalid(format!("{e} (the fields are in docs/studies.md)")))?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let name = f.name.clone().unwrap_or_else(|| path.file_stem().and_then(|s| s.to_str()).unwrap_or("study").to_string());

@@ -39,10 +39,22 @@ impl RunSpec {
     }
 }
 
+/// Most runs a study may plan: 10 000 (the wedge study plans 60; a dam campaign a few hundred).
+/// Checked on the product of the selected axis values before any run is enumerated: a study
+/// whose axes multiplied to 10¹² planned for ever (issue 33).
+pub const MAX_STUDY_RUNS: usize = 10_000;
+
 /// Every run of the study, without duplicates, the most expensive first (stable: in selection
 /// order within a cost), so that `make -j` starts the long runs early.
 pub fn plan_runs(study: &Study) -> Result<Vec<RunSpec>, StudyError> {
     let mut runs: Vec<RunSpec> = Vec::new();
+    let combinations: f64 = study.selections.iter().map(|sel| sel.labels.iter().map(|l| l.len() as f64).product::<f64>()).sum();
+    if combinations > MAX_STUDY_RUNS as f64 {
+        return Err(StudyError::Invalid {
+            path: study.path.clone(),
+            message: format!("the selections' axes multiply to {combinations:.3e} runs, above the limit of {MAX_STUDY_RUNS}: select fewer values (a study of that size is a cluster campaign: split it into several studies)"),
+        });
+    }
     for sel in &study.selections {
         // the product of the selected labels, the first axis outermost
         let mut idx = vec![0usize; study.axes.len()];
@@ -82,6 +94,9 @@ pub fn plan_runs(study: &Study) -> Result<Vec<RunSpec>, StudyError> {
         let invalid = |message: String| StudyError::Invalid { path: study.path.clone(), message };
         if r.id.is_empty() {
             return Err(invalid(format!("a run has only empty labels ({:?}): give one of its values a label", r.labels)));
+        }
+        if !crate::files::is_file_stem(&r.id) {
+            return Err(invalid(format!("run id \"{}\" ({:?}) is not a file name: at most {} characters of letters, digits, `.`, `_`, `+`, `-` (shorten the labels or leave axes out of `id`)", r.id, r.labels, crate::files::MAX_STEM_LEN)));
         }
         if let Some(o) = runs[..i].iter().find(|o| o.id == r.id) {
             return Err(invalid(format!("runs {:?} and {:?} get the same id \"{}\": give their values distinct labels (or add the axis to `id`)", o.labels, r.labels, r.id)));
@@ -204,7 +219,7 @@ fn apply_pga(s: &mut Scene, pga: f64) -> Result<(), Error> {
             && sy.pga.is_none()
         {
             let ratio = crate::motion::SynthRequest::new(sy.spectrum.clone(), 1.0, sy.seed).vertical_ratio;
-            sy.pga = b.pga.map(|p| if sy.component == "v" { p / ratio } else { p });
+            sy.pga = b.pga.map(|p| if sy.component == crate::scene::SynthComponent::V { p / ratio } else { p });
         }
         b.scale = Some(m.scale * f);
         b.pga = None;

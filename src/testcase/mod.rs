@@ -302,6 +302,16 @@ fn invalid(option: &str, message: impl Into<String>) -> Error {
     CaseError::Invalid { option: option.into(), message: message.into() }.into()
 }
 
+/// The numeric command-line options of `jointquake testcase`, each finite when given: a NaN
+/// or inf option became JSON `null` on its way to [`CaseSpec`] and so silently the default
+/// (issue 34). The error names the option.
+pub fn check_finite_options(opts: &[(&str, Option<f64>)]) -> Result<(), Error> {
+    match opts.iter().find(|(_, v)| v.is_some_and(|x| !x.is_finite())) {
+        Some((name, Some(v))) => Err(invalid(name, format!("{v}: give a finite number"))),
+        _ => Ok(()),
+    }
+}
+
 impl CaseSpec {
     /// Defaults filled in and every option checked (an error names the option and the fix).
     pub fn resolved(&self) -> Result<Resolved, Error> {

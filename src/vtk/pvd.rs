@@ -39,8 +39,6 @@ impl PvdSeries {
             let _ = writeln!(s, "    <DataSet timestep=\"{t:.9e}\" group=\"\" part=\"0\" file=\"{f}\"/>");
         }
         s.push_str("  </Collection>\n</VTKFile>\n");
-        let tmp = self.path.with_extension("pvd.tmp");
-        std::fs::write(&tmp, s).map_err(|e| OutputError::write(&tmp, e))?;
-        std::fs::rename(&tmp, &self.path).map_err(|e| OutputError::write(&self.path, e))
+        crate::files::write_whole(&self.path, s.as_bytes()).map_err(|(p, m)| OutputError::write(p, m))
     }
 }

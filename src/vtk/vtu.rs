@@ -164,10 +164,8 @@ pub fn write_vtu_labelled(path: &Path, grid: &Grid, point_fields: &[Field], cell
     data_array_into(&mut x, "Int64", Some("offsets"), 1, &le_bytes(&offsets, i64::to_le_bytes));
     data_array_into(&mut x, "UInt8", Some("types"), 1, &types);
     x.push_str("</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    let tmp = path.with_extension("vtu.tmp");
-    std::fs::write(&tmp, x).map_err(|e| OutputError::write(&tmp, e))?;
-    std::fs::rename(&tmp, path).map_err(|e| OutputError::write(path, e))?;
-    Ok(())
+    // whole, the temporary file removed on a full disk (issue 34), never over a non-regular file
+    crate::files::write_whole(path, x.as_bytes()).map_err(|(p, m)| OutputError::write(p, m))
 }
 
 /// Read back the Float64 `<DataArray>` named `name` (point or cell data) of a VTU written by

@@ -128,6 +128,9 @@ fn inverted_element_is_named_with_its_group() {
 fn time_step_above_the_limit_quotes_the_limit_and_the_critical_element() {
     let mut s = column_scene();
     s["time"]["dt"] = json!(1.0);
+    // a duration of at least dt / 2, so that the step is refused for its stability and not for
+    // taking no step (`a_time_step_above_twice_the_duration_is_refused`)
+    s["time"]["duration"] = json!(1.0);
     let msg = run_error("dt_unstable", &s);
     // the reference: the model's own stable step and critical element
     let scene: Scene = serde_json::from_value(column_scene()).unwrap();

@@ -257,6 +257,7 @@ fn run_bad_scenes_fail_cleanly_naming_the_culprit() {
 
     let mut s = column(json!({}));
     s["time"]["dt"] = json!(0.5);
+    s["time"]["duration"] = json!(1.0); // dt ≤ 2 × duration: refused for its stability, not for taking no step
     assert_clean_failure(&cli_on_scene("dt", "run", &s), &["above the stability limit", "critical element", "\"block:column\""]);
 
     let mut s = column(json!({}));

@@ -205,3 +205,209 @@ fn fuzz_mutated_scenes_run_or_fail_cleanly() {
         panic!("column scene: {e}");
     }
 }
+
+// ---- issues 33 and 34: numbers to the extremes, hostile names, wildcards, repeats, targets ----
+
+/// Run `check` on `cases()` values of `strategy` with a fixed seed (`seed` byte).
+fn fuzz_values<S: Strategy>(name: &str, seed: u8, cases: u32, strategy: S, check: impl Fn(S::Value) -> Result<(), TestCaseError>) {
+    let mut r = TestRunner::new_with_rng(Config { cases, failure_persistence: None, ..Config::default() }, TestRng::from_seed(RngAlgorithm::ChaCha, &[seed; 32]));
+    if let Err(e) = r.run(&strategy, check) {
+        panic!("{name}: {e}");
+    }
+}
+
+/// A scene with a value at every numeric field the checks bound (loads, damping, time,
+/// equilibrium, output, joints, reservoir).
+fn full_numeric_scene() -> serde_json::Value {
+    serde_json::json!({
+        "geometry": {"msh": fixture("boxes_hex_4x3.msh")},
+        "materials": [{"group": "block:lower", "E": 30e9, "nu": 0.2, "rho": 2400}, {"group": "block:upper", "E": 30e9, "nu": 0.2, "rho": 2400}],
+        "boundary": [{"group": "bc:base"}],
+        "loads": {"gravity": {"g": 9.81, "direction": [0, 0, -1]},
+                  "traction": [{"group": "joint:J:upper", "traction": [0, 0, -1e5], "ramp": 0.001}],
+                  "nodal": [{"point": [0, 0, 0.5], "force": [1e3, 0, 0], "ramp": 0.0}]},
+        "damping": {"alpha": 1.0, "beta": 1e-5},
+        "time": {"duration": 0.001, "courant": 0.9, "energy_tolerance": 0.05, "max_steps": 100000},
+        "equilibrium": {"tolerance": 1e-6, "max_residual": 1e-3, "max_steps": 2000},
+        "output": {"frames": false, "history_interval": 1e-4, "monitor": [{"name": "m", "point": [0, 0, 0.5]}]},
+        "joints": [{"name": "J", "master": "joint:J:lower", "slave": "joint:J:upper", "mu": 0.6, "cohesion": 0.0, "tensile_strength": 0.0, "edge_tolerance": 1e-3}],
+        "reservoir": {"faces": ["joint:J:upper"], "level": 1.0, "rho_w": 1000.0},
+        "g": 9.81
+    })
+}
+
+/// JSON paths of every number in `v` (arrays by index).
+fn number_paths(v: &serde_json::Value, at: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+    match v {
+        serde_json::Value::Number(_) => out.push(at.clone()),
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                at.push(k.clone());
+                number_paths(x, at, out);
+                at.pop();
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                at.push(i.to_string());
+                number_paths(x, at, out);
+                at.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+fn at_path<'a>(v: &'a mut serde_json::Value, path: &[String]) -> &'a mut serde_json::Value {
+    path.iter().fold(v, |v, k| match v {
+        serde_json::Value::Array(a) => &mut a[k.parse::<usize>().unwrap()],
+        other => &mut other[k.as_str()],
+    })
+}
+
+/// Issue 33 §6: every numeric scene field set to ±1e308, 0, a denormal, a huge integer or (as
+/// a JSON text) NaN/inf: the scene loads or is refused with an error, never a panic; an accepted
+/// one runs (one case in 50: each run takes a mesh and a few steps) to a finite peak or an
+/// error. NaN cannot be written as a JSON number: its texts ("NaN", 1e999) are parse errors.
+#[test]
+fn fuzz_every_numeric_scene_field_to_the_extremes() {
+    use jointquake::pipeline::{run, RunOptions};
+    let base = full_numeric_scene();
+    let mut paths = Vec::new();
+    number_paths(&base, &mut Vec::new(), &mut paths);
+    let dir = scratch("fuzz/numeric_fields");
+    let p = dir.join("scene.json");
+    let opts = RunOptions { out_dir: Some(dir.join("out")), ..Default::default() };
+    let extremes = ["1e308", "-1e308", "0", "-0", "5e-324", "-1", "18446744073709551615", "1e999", "NaN"];
+    fuzz_values("numeric fields", 11, cases(), (0..paths.len(), 0..extremes.len(), 0u32..50), |(k, e, r)| {
+        let mut s = base.clone();
+        *at_path(&mut s, &paths[k]) = serde_json::Value::String("@@".into());
+        let text = serde_json::to_string(&s).unwrap().replace("\"@@\"", extremes[e]);
+        std::fs::write(&p, text).unwrap();
+        if jointquake::scene::Scene::load(&p).is_ok() && r == 0 {
+            if let Ok(sum) = run(&p, &opts) {
+                prop_assert!(sum.peak_displacement.value.is_finite(), "non-finite peak with {} = {}", paths[k].join("."), extremes[e]);
+            }
+        }
+        Ok(())
+    });
+}
+
+/// Issue 33 §2: any name (slashes, dots, NUL, unicode, 300 characters) becomes a stem that is
+/// its own stem, at most 100 bytes, and stays under the output directory when joined.
+#[test]
+fn fuzz_hostile_names_become_stems_under_out() {
+    let chars = proptest::sample::select(vec!['a', 'Z', '0', '.', '/', '\\', '\0', ' ', ':', '-', '_', '+', 'é', '~', '*', '\n']);
+    fuzz_values("names", 12, cases(), proptest::collection::vec(chars, 0..300), |v| {
+        let name: String = v.into_iter().collect();
+        let stem = jointquake::files::file_stem(&name);
+        prop_assert!(jointquake::files::is_file_stem(&stem) && stem.len() <= jointquake::files::MAX_STEM_LEN && !stem.starts_with('.'));
+        let p = jointquake::files::path_under(std::path::Path::new("out"), &format!("joint_{stem}_forces.csv")).unwrap();
+        prop_assert!(p.parent() == Some(std::path::Path::new("out")), "{p:?}");
+        Ok(())
+    });
+}
+
+/// The readings (up to 2) of `name` by a pattern, by plain backtracking: the reference the
+/// linear matcher must agree with (exponential, so only on short inputs).
+fn naive_readings(p: &str, name: &str) -> usize {
+    fn go(p: &[char], s: &[char]) -> usize {
+        match p.first() {
+            None => usize::from(s.is_empty()),
+            Some('*') => (0..=s.iter().position(|&c| c == ':').unwrap_or(s.len())).map(|e| go(&p[1..], &s[e..])).sum::<usize>().min(2),
+            Some('#') => (1..=s.iter().position(|&c| c == ':').unwrap_or(s.len())).map(|e| go(&p[1..], &s[e..])).sum::<usize>().min(2),
+            Some(c) => if s.first() == Some(c) { go(&p[1..], &s[1..]) } else { 0 },
+        }
+    }
+    let pc: Vec<char> = p.chars().collect();
+    let sc: Vec<char> = name.chars().collect();
+    go(&pc, &sc)
+}
+
+/// Issue 33 §3: patterns with many wildcards answer at once and as plain backtracking does
+/// (no match, one reading, or ambiguous) on short names; long ones (60 parts, 2000
+/// characters) within 0.2 s each.
+#[test]
+fn fuzz_patterns_with_many_wildcards_match_fast_and_right() {
+    use jointquake::mesh::pattern::{GroupPattern, PatternError};
+    let tok = proptest::sample::select(vec!["*", "#", "a", "b", ":", "ab"]);
+    let letter = proptest::sample::select(vec!['a', 'b', ':']);
+    fuzz_values("patterns", 13, cases(), (proptest::collection::vec(tok, 1..10), proptest::collection::vec(letter, 0..14)), |(toks, name)| {
+        // '#' is a placeholder {Pn}; two wildcards may not touch (the parser refuses it)
+        let mut text = String::new();
+        let mut naive = String::new();
+        for (i, t) in toks.iter().enumerate() {
+            if *t == "#" {
+                text.push_str(&format!("{{P{i}}}"));
+            } else {
+                text.push_str(t);
+            }
+            naive.push_str(t);
+        }
+        let name: String = name.into_iter().collect();
+        let Ok(p) = GroupPattern::parse(&text) else { return Ok(()) };
+        let want = naive_readings(&naive, &name);
+        match p.match_name(&name) {
+            Ok(None) => prop_assert_eq!(want, 0, "{} on {}", text, name),
+            Ok(Some(_)) => prop_assert_eq!(want, 1, "{} on {}", text, name),
+            Err(PatternError::Ambiguous { .. }) => prop_assert_eq!(want, 2, "{} on {}", text, name),
+            Err(e) => prop_assert!(false, "{e}"),
+        }
+        Ok(())
+    });
+    fuzz_values("long patterns", 14, (cases() / 20).max(10), (1usize..30, 100usize..2000), |(stars, len)| {
+        let p = GroupPattern::parse(&format!("g:{}b", "*a".repeat(stars))).unwrap();
+        let t = std::time::Instant::now();
+        let _ = p.match_name(&format!("g:{}", "a".repeat(len)));
+        prop_assert!(t.elapsed().as_secs_f64() < 0.2, "{stars} stars on {len} characters: {:?}", t.elapsed());
+        Ok(())
+    });
+}
+
+/// Issue 34: group lists with repeats (reservoir faces, gravity groups, mass groups, envelope
+/// faces) are refused exactly when a group repeats; and writes to non-regular targets
+/// (device, symlink, directory, fifo) are refused and leave them as they were.
+#[test]
+fn fuzz_repeated_groups_and_non_regular_targets() {
+    let dir = scratch("fuzz/repeats");
+    let p = dir.join("scene.json");
+    let group = proptest::sample::select(vec!["joint:J:upper", "joint:J:lower", "bc:base"]);
+    let field = 0usize..4;
+    fuzz_values("repeats", 15, (cases() / 4).max(10), (field, proptest::collection::vec(group, 1..5)), |(f, groups)| {
+        let mut s = full_numeric_scene();
+        let list = serde_json::json!(groups);
+        match f {
+            0 => s["reservoir"]["faces"] = list,
+            1 => s["loads"]["gravity"]["groups"] = list,
+            2 => s["damping"]["mass_groups"] = list,
+            _ => s["output"]["envelope"] = serde_json::json!({"faces": list}),
+        }
+        std::fs::write(&p, serde_json::to_string(&s).unwrap()).unwrap();
+        let repeats = groups.iter().enumerate().any(|(i, g)| groups[..i].contains(g));
+        match jointquake::scene::Scene::load(&p) {
+            Ok(_) => prop_assert!(!repeats, "accepted {groups:?} in field {f}"),
+            Err(e) => prop_assert!(!repeats || e.to_string().contains("listed twice"), "{e}"),
+        }
+        Ok(())
+    });
+    let target = dir.join("real.txt");
+    std::fs::write(&target, "keep").unwrap();
+    let link = dir.join("link.txt");
+    let _ = std::fs::remove_file(&link);
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let fifo = dir.join("fifo");
+    if !fifo.exists() {
+        let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+        unsafe { libc::mkfifo(c.as_ptr(), 0o600) };
+    }
+    let targets = [PathBuf::from("/dev/null"), link.clone(), dir.join("sub"), fifo.clone()];
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    fuzz_values("targets", 16, (cases() / 20).max(10), (0..targets.len(), proptest::collection::vec(any::<u8>(), 0..64)), |(k, bytes)| {
+        let t = &targets[k];
+        let before = std::fs::symlink_metadata(t).unwrap().file_type();
+        prop_assert!(jointquake::files::write_whole(t, &bytes).is_err());
+        prop_assert_eq!(std::fs::symlink_metadata(t).unwrap().file_type(), before);
+        Ok(())
+    });
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep");
+}

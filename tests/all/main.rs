@@ -15,6 +15,7 @@ mod dam_study;
 mod dynamics;
 mod foundation;
 mod fuzz;
+mod hardening;
 mod joint_tests;
 mod mesh;
 mod mortar;

@@ -158,7 +158,9 @@ fn killed_run_leaves_a_valid_pvd_series() {
         "boundary": [{"group": "bc:bottom"}],
         "loads": {"gravity": {}},
         "equilibrium": {"method": "none"},
-        "time": {"duration": 100.0},
+        // 4 s at dt 4.09e-5 s: 97 800 frames, under output::recorder::MAX_FRAMES (100 s asked
+        // for 2.4 million and is refused before the run since issue 33)
+        "time": {"duration": 4.0},
         "output": {"frame_stride": 1, "monitor": [{"name": "top", "point": [0, 0, 1]}]}
     });
     write_scene(&dir, &scene);

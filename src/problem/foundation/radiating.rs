@@ -26,7 +26,8 @@
 
 use super::free_field::FreeField;
 use crate::constraint::{Constraint, ConstraintInfo, StepContext};
-use crate::dynamics::loads::{face_node_areas, Loads};
+use crate::dynamics::loads::Loads;
+use crate::interface::{face_nodal_weights_into, FaceWeights};
 use crate::error::{ModelError, StepError};
 use crate::mesh::CellKind;
 use crate::model::Model;
@@ -108,7 +109,13 @@ impl FarFaces<'_> {
                     let r = r.unwrap_or_else(|| (centre - Vector3::from(self.source)).norm());
                     (nn * SPRING_NORMAL + tt * SPRING_TANGENT) * (self.shear_modulus / r.max(1e-9))
                 });
-                let w = face_node_areas(cell.kind, &x);
+                let mut xa = [[0.0; 3]; 4];
+                for (xi, p) in xa.iter_mut().zip(&x) {
+                    *xi = [p.x, p.y, p.z];
+                }
+                let mut fw = FaceWeights::default();
+                face_nodal_weights_into(cell.kind, &xa[..x.len()], &mut fw);
+                let w = fw.area;
                 for (a, &nd) in cell.nodes().iter().enumerate() {
                     let nd = nd as usize;
                     if index[nd] == usize::MAX {

@@ -289,7 +289,7 @@ fn lower_boundary_nodes(faces: &[WetFace], mesh: &Mesh, level: f64) -> Vec<usize
 pub fn reservoir_spec(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[WetFace], scene: &crate::scene::Scene) -> ReservoirSpec {
     let lowest = faces.iter().flat_map(|f| f.nodes.iter()).map(|&v| mesh.nodes[v][2]).fold(f64::INFINITY, f64::min);
     let g = scene.loads.gravity.as_ref().map(|g| g.g).unwrap_or(scene.g);
-    let local_depth = r.added_mass_depth == "local" || r.model == ReservoirModel::WestergaardLocal;
+    let local_depth = r.added_mass_depth == crate::scene::AddedMassDepth::Local || r.model == ReservoirModel::WestergaardLocal;
     ReservoirSpec { rho_w: r.rho_w, level: r.level, bottom: r.bottom.unwrap_or(lowest), g, local_depth }
 }
 
