@@ -1,7 +1,7 @@
 //! Bad input through the library (`pipeline::run`, `pipeline::tag`): every error must NAME the
 //! culprit (key, group, file, element, line, value) and say what to fix. Scenes are written into
 //! scratch directories and point at the committed fixtures by absolute path.
-use crate::common::{fixture, scratch};
+use crate::common::{assert_mentions, fixture, run_error_at, scratch};
 use jointquake::mesh::Mesh;
 use jointquake::model::Model;
 use jointquake::pipeline::{run, tag, RunOptions};
@@ -31,17 +31,7 @@ fn column_scene() -> Value {
 /// The error message of `run` on `scene` (which must fail).
 fn run_error(test: &str, scene: &Value) -> String {
     let (p, dir) = write_scene(test, scene);
-    let opts = RunOptions { out_dir: Some(dir.join("out")), mesh_cache: Some(dir.join("mesh")), progress: false, duration: None, threads: None };
-    match run(&p, &opts) {
-        Ok(_) => panic!("{test}: the run should fail"),
-        Err(e) => e.to_string(),
-    }
-}
-
-fn assert_mentions(msg: &str, parts: &[&str]) {
-    for p in parts {
-        assert!(msg.contains(p), "message does not mention {p:?}:\n{msg}");
-    }
+    run_error_at(test, &p, &dir)
 }
 
 #[test]

@@ -72,3 +72,20 @@ pub fn simulate_contact(problem: &Problem, steps: usize, relax: bool, mut observ
     }
     (sim.dt(), sim.state)
 }
+
+/// The error message of `jointquake::pipeline::run` on the scene file `scene` (which must
+/// fail), its outputs and mesh cache under `dir`; `test` names the case in the panic.
+pub fn run_error_at(test: &str, scene: &std::path::Path, dir: &std::path::Path) -> String {
+    let opts = jointquake::pipeline::RunOptions { out_dir: Some(dir.join("out")), mesh_cache: Some(dir.join("mesh")), ..Default::default() };
+    match jointquake::pipeline::run(scene, &opts) {
+        Ok(_) => panic!("{test}: the run should fail"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// `msg` contains every one of `parts` (an error names its field, value and fix).
+pub fn assert_mentions(msg: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(msg.contains(p), "message does not mention {p:?}:\n{msg}");
+    }
+}

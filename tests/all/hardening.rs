@@ -1,7 +1,7 @@
 //! Hardening, third round (issues 33 and 34): one regression test per class of hostile input,
 //! named after it. Each either checks the clear error (naming the field, the value and the
 //! limit) or that what is written stays where it belongs.
-use crate::common::{fixture, scratch};
+use crate::common::{assert_mentions, fixture, run_error_at, scratch};
 use jointquake::pipeline::{run, RunOptions};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
@@ -41,17 +41,7 @@ fn write_scene(test: &str, scene: &Value) -> (PathBuf, PathBuf) {
 
 fn run_error(test: &str, scene: &Value) -> String {
     let (p, dir) = write_scene(test, scene);
-    let opts = RunOptions { out_dir: Some(dir.join("out")), mesh_cache: Some(dir.join("mesh")), ..Default::default() };
-    match run(&p, &opts) {
-        Ok(_) => panic!("{test}: the run should fail"),
-        Err(e) => e.to_string(),
-    }
-}
-
-fn assert_mentions(msg: &str, parts: &[&str]) {
-    for p in parts {
-        assert!(msg.contains(p), "message does not mention {p:?}:\n{msg}");
-    }
+    run_error_at(test, &p, &dir)
 }
 
 /// Every file under `dir` (recursively).
