@@ -98,12 +98,11 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
         }
         scene.time.duration = d;
     }
-    let phase = interrupt_phase;
     let mesh = load_scene_mesh(&mut scene, scene_path, opts.mesh_cache.as_deref())?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");
     let problem = Problem::build(scene, mesh)?;
-    phase("the model's build (records, reservoir, joints)")?;
+    interrupt_phase("the model's build (records, reservoir, joints)")?;
     laps.lap("model");
     let threads = opts.threads.unwrap_or_else(|| default_threads(problem.model.n_elements(), rayon::current_num_threads()));
     let simulate = || -> Result<RunSummary, Error> {
@@ -111,7 +110,7 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
         let out_dir = opts.out_dir.clone().unwrap_or_else(|| problem.scene.output_dir());
         crate::output::recorder::check_outputs(&sim, &out_dir)?;
         sim.equilibrate()?;
-        phase("the static state")?;
+        interrupt_phase("the static state")?;
         laps.lap("equilibrium");
         inspect(&sim, &out_dir)?;
         let mut recorder = Recorder::create(&sim, &out_dir, opts.progress)?;

@@ -234,8 +234,29 @@ impl ExplicitSolver {
         &self.f_int
     }
 
-    /// Advance `state` from t[n] to t[n+1].
+    /// Advance `state` from t[n] to t[n+1]: the forces at t[n], the prediction of u[n+1] with
+    /// the constraints' corrections and the energy increments, the energy account, the shift.
     pub fn step(&mut self, model: &Model, loads: &Loads, state: &mut State, stage: Stage, constraints: Constraints<'_, '_>) -> Result<StepInfo, StepError> {
+        let dynamic = stage == Stage::Dynamic;
+        let (alpha, beta) = self.external_forces_of_step(model, loads, state, stage, constraints);
+        self.internal_forces_of_step(model, state, beta, constraints);
+        let (sums, info) = self.update_into(model, state, StepCoefficients { alpha, beta, dynamic }, constraints)?;
+        if dynamic {
+            add_step_energy(&mut state.energy, sums, &info);
+        }
+        if !sums[3].is_finite() {
+            return Err(self.non_finite_error(model, state));
+        }
+        self.shift_into(state, beta);
+        if dynamic && (state.step % self.energy_stride == 0) {
+            self.check_energy(model, state)?;
+        }
+        Ok(info)
+    }
+
+    /// F[n] into `f_ext`: the loads (gravity scaled by the relaxation's ramp), then the
+    /// constraints' external forces. Returns the stage's damping (α [1/s], β [s]).
+    fn external_forces_of_step(&mut self, model: &Model, loads: &Loads, state: &State, stage: Stage, constraints: Constraints<'_, '_>) -> (f64, f64) {
         let dt = self.dt;
         let dynamic = stage == Stage::Dynamic;
         loads.external_force_into(model, state.t, true, dynamic, &mut self.f_ext);
@@ -248,18 +269,17 @@ impl ExplicitSolver {
                 (a, 0.0)
             }
         };
-        {
-            let ctx = StepContext { t_next: state.t + dt, dt, u_prev: &state.u_prev, u: &state.u };
-            for c in constraints.iter_mut() {
-                c.add_external_force_into(model, &ctx, dynamic, &mut self.f_ext);
-            }
+        let ctx = StepContext { t_next: state.t + dt, dt, u_prev: &state.u_prev, u: &state.u };
+        for c in constraints.iter_mut() {
+            c.add_external_force_into(model, &ctx, dynamic, &mut self.f_ext);
         }
-        let held: &[u8] = match (&self.dynamic_held, dynamic) {
-            (Some(h), true) => h,
-            _ => &model.held,
-        };
+        (alpha, beta)
+    }
+
+    /// K u[n] into `f_int`, or with β > 0 K(u[n] + β v_b) into `f_int` and K u[n] into `ku`.
+    fn internal_forces_of_step(&mut self, model: &Model, state: &State, beta: f64, constraints: Constraints<'_, '_>) {
         if beta > 0.0 {
-            let c = beta / dt;
+            let c = beta / self.dt;
             for_each_entry(&mut self.w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
             internal_forces_into(model, constraints, &self.w, &mut self.f_int);
             // f_int = (1 + c) K u[n] − c K u[n−1] by linearity, so K u[n] follows exactly from
@@ -269,124 +289,63 @@ impl ExplicitSolver {
         } else {
             internal_forces_into(model, constraints, &state.u, &mut self.f_int);
         }
-        let dt2 = dt * dt;
-        // energy increments over the step, Δu_c = (u[n+1] − u[n−1]) / 2: W_ext, D_α, D_β, and
-        // Σ u[n+1]·0 (non-finite when some u[n+1] is), over the entries r; `u_next` holds the
-        // entries from r.start on
-        let increments = |r: std::ops::Range<usize>, u_next: &[f64]| -> [f64; 4] {
-            let (mut wext, mut damp, mut sdamp, mut finite) = (0.0, 0.0, 0.0, 0.0);
-            let first = r.start;
-            for i in r {
-                let un = u_next[i - first];
-                finite += un * 0.0;
-                if dynamic {
-                    let du = 0.5 * (un - state.u_prev[i]);
-                    wext += du * self.f_ext[i];
-                    if beta > 0.0 {
-                        sdamp += du * (self.f_int[i] - self.ku[i]);
-                    }
-                    if alpha > 0.0 && model.mass_damped[i / 3] {
-                        let vb = (state.u[i] - state.u_prev[i]) / dt;
-                        damp += du * alpha * model.mass.inertial[i / 3] * vb;
-                    }
-                }
-            }
-            [wext, damp, sdamp, finite]
+    }
+
+    /// u[n+1] into `u_next`: the prediction, one block of nodes per task, the block nodes,
+    /// then the constraints' corrections. Returns the energy increments W_ext, D_α, D_β and
+    /// the finiteness probe ([`StepTerms::increments`]) and the corrections' information. With
+    /// no constraint and no block node the increments are taken in the prediction's pass
+    /// (u[n+1] is final there).
+    fn update_into(&mut self, model: &Model, state: &mut State, k: StepCoefficients, constraints: Constraints<'_, '_>) -> Result<([f64; 4], StepInfo), StepError> {
+        let held: &[u8] = match (&self.dynamic_held, k.dynamic) {
+            (Some(h), true) => h,
+            _ => &model.held,
         };
-        // the update, one block of nodes per task; with no constraint and no block node the
-        // increments are taken in the same pass (u[n+1] is final)
-        let blocks = &model.mass.blocks;
-        let fused = constraints.is_empty() && blocks.is_empty();
-        let parts: Vec<[f64; 4]> = map_blocks_mut(&mut self.u_next, |b, un| {
-            let first = b * NODE_BLOCK;
-            for (k, unode) in un.chunks_exact_mut(3).enumerate() {
-                let node = first + k;
-                let m = model.mass.inertial[node];
-                let fx = held[node];
-                for c in 0..3 {
-                    let i = 3 * node + c;
-                    if fx & (1 << c) != 0 {
-                        unode[c] = 0.0;
-                        continue;
-                    }
-                    let vb = (state.u[i] - state.u_prev[i]) / dt;
-                    let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
-                    let a = (self.f_ext[i] - self.f_int[i]) / m - an * vb;
-                    unode[c] = 2.0 * state.u[i] - state.u_prev[i] + dt2 * a;
-                }
-            }
-            if fused { increments(3 * first..3 * first + un.len(), un) } else { [0.0; 4] }
-        });
-        // block nodes: a = M⁻¹ (F − K u) − α v_b with their full inverse (on free components)
-        for b in blocks {
-            let node = b.node as usize;
-            let i0 = 3 * node;
-            let f = nalgebra::Vector3::from_fn(|c, _| self.f_ext[i0 + c] - self.f_int[i0 + c]);
-            let a = b.inverse * f;
-            let an = if dynamic && !model.mass_damped[node] { 0.0 } else { alpha };
-            for c in 0..3 {
-                let i = i0 + c;
-                self.u_next[i] = if held[node] & (1 << c) != 0 {
-                    0.0
-                } else {
-                    let vb = (state.u[i] - state.u_prev[i]) / dt;
-                    2.0 * state.u[i] - state.u_prev[i] + dt2 * (a[c] - an * vb)
-                };
-            }
-        }
+        let terms = StepTerms { model, u: &state.u, u_prev: &state.u_prev, f_ext: &self.f_ext, f_int: &self.f_int, ku: &self.ku, held, dt: self.dt, k };
+        let fused = constraints.is_empty() && model.mass.blocks.is_empty();
+        let parts: Vec<[f64; 4]> = map_blocks_mut(&mut self.u_next, |b, un| terms.predict_block_into(b, un, fused));
+        terms.predict_block_nodes_into(&mut self.u_next);
         let mut info = StepInfo::default();
-        let sums = if fused {
-            add_parts(&parts)
-        } else {
-            let ctx = StepContext { t_next: state.t + dt, dt, u_prev: &state.u_prev, u: &state.u };
-            for c in constraints.iter_mut() {
-                let ci = c.correct(model, &mut state.contact, &ctx, &mut self.u_next)?;
-                info.correction = std::mem::take(&mut info.correction).merged(ci);
-            }
-            let mut s = sum_blocks(self.u_next.len(), |r| increments(r.clone(), &self.u_next[r]));
-            if dynamic && alpha > 0.0 {
-                // mass damping of the added inertia A: Δu_c · α A v_b
-                for b in blocks.iter().filter(|b| model.mass_damped[b.node as usize]) {
-                    let i0 = 3 * b.node as usize;
-                    let du = nalgebra::Vector3::from_fn(|c, _| 0.5 * (self.u_next[i0 + c] - state.u_prev[i0 + c]));
-                    let vb = nalgebra::Vector3::from_fn(|c, _| (state.u[i0 + c] - state.u_prev[i0 + c]) / dt);
-                    s[1] += du.dot(&(b.added * vb)) * alpha;
-                }
-            }
-            s
-        };
-        if dynamic {
-            let e = &mut state.energy;
-            e.external_work += sums[0];
-            e.mass_damping += sums[1];
-            e.stiffness_damping += sums[2];
-            e.contact_work += info.correction.work;
+        if fused {
+            return Ok((add_parts(&parts), info));
         }
-        if !sums[3].is_finite() {
-            let i = self.u_next.iter().position(|v| !v.is_finite()).unwrap_or(0);
-            let node = i / 3;
-            return Err(StepError::NonFinite {
-                what: "displacement".into(),
-                step: state.step,
-                t: state.t,
-                node: model.mesh.node_tags[node] as usize,
-                x: model.mesh.nodes[node],
-                cause: "the time step is too large for the stiffest element or contact, or a load/record holds a non-finite value".into(),
-            });
+        let ctx = StepContext { t_next: state.t + self.dt, dt: self.dt, u_prev: &state.u_prev, u: &state.u };
+        for c in constraints.iter_mut() {
+            let ci = c.correct(model, &mut state.contact, &ctx, &mut self.u_next)?;
+            info.correction = std::mem::take(&mut info.correction).merged(ci);
         }
+        let mut s = sum_blocks(self.u_next.len(), |r| terms.increments(r.clone(), &self.u_next[r]));
+        if k.dynamic && k.alpha > 0.0 {
+            terms.add_block_mass_damping(&self.u_next, &mut s[1]);
+        }
+        Ok((s, info))
+    }
+
+    /// The error for a non-finite u[n+1] (`u_next`), at its first non-finite entry's node.
+    fn non_finite_error(&self, model: &Model, state: &State) -> StepError {
+        let i = self.u_next.iter().position(|v| !v.is_finite()).unwrap_or(0);
+        let node = i / 3;
+        StepError::NonFinite {
+            what: "displacement".into(),
+            step: state.step,
+            t: state.t,
+            node: model.mesh.node_tags[node] as usize,
+            x: model.mesh.nodes[node],
+            cause: "the time step is too large for the stiffest element or contact, or a load/record holds a non-finite value".into(),
+        }
+    }
+
+    /// The end of a step: K u[n] becomes K u[n−1] (β > 0); u_nm1 ← u[n−1], u_prev ← u[n],
+    /// u ← u[n+1]; the step index and t advance.
+    fn shift_into(&mut self, state: &mut State, beta: f64) {
         if beta > 0.0 {
             std::mem::swap(&mut self.ku, &mut self.ku_prev);
         }
-        // shift: u_nm1 ← u[n−1], u_prev ← u[n], u ← u[n+1]
         std::mem::swap(&mut self.u_nm1, &mut state.u_prev);
         std::mem::swap(&mut state.u_prev, &mut state.u);
         std::mem::swap(&mut state.u, &mut self.u_next);
         state.step += 1;
-        state.t += dt;
-        if dynamic && (state.step % self.energy_stride == 0) {
-            self.check_energy(model, state)?;
-        }
-        Ok(info)
+        state.t += self.dt;
     }
 
     /// Start the energy account of the dynamic stage from the current state (at rest).
@@ -476,6 +435,125 @@ impl ExplicitSolver {
         }
         Ok(())
     }
+}
+
+/// The damping of a step's stage (α [1/s], β [s]) and whether it is the dynamic stage.
+#[derive(Clone, Copy, Debug)]
+struct StepCoefficients {
+    alpha: f64,
+    beta: f64,
+    dynamic: bool,
+}
+
+/// What the update of one step reads: u[n], u[n−1], the forces at t[n] (K u[n] in `ku` when
+/// β > 0), the held components of the stage.
+struct StepTerms<'a> {
+    model: &'a Model,
+    u: &'a [f64],
+    u_prev: &'a [f64],
+    f_ext: &'a [f64],
+    f_int: &'a [f64],
+    ku: &'a [f64],
+    held: &'a [u8],
+    dt: f64,
+    k: StepCoefficients,
+}
+
+impl StepTerms<'_> {
+    /// Energy increments over the step, Δu_c = (u[n+1] − u[n−1]) / 2: W_ext, D_α, D_β, and
+    /// Σ u[n+1]·0 (non-finite when some u[n+1] is), over the entries `r`; `u_next` holds the
+    /// entries from r.start on.
+    fn increments(&self, r: std::ops::Range<usize>, u_next: &[f64]) -> [f64; 4] {
+        let (dt, alpha, beta) = (self.dt, self.k.alpha, self.k.beta);
+        let (mut wext, mut damp, mut sdamp, mut finite) = (0.0, 0.0, 0.0, 0.0);
+        let first = r.start;
+        for i in r {
+            let un = u_next[i - first];
+            finite += un * 0.0;
+            if self.k.dynamic {
+                let du = 0.5 * (un - self.u_prev[i]);
+                wext += du * self.f_ext[i];
+                if beta > 0.0 {
+                    sdamp += du * (self.f_int[i] - self.ku[i]);
+                }
+                if alpha > 0.0 && self.model.mass_damped[i / 3] {
+                    let vb = (self.u[i] - self.u_prev[i]) / dt;
+                    damp += du * alpha * self.model.mass.inertial[i / 3] * vb;
+                }
+            }
+        }
+        [wext, damp, sdamp, finite]
+    }
+
+    /// u[n+1] = 2u[n] − u[n−1] + dt² (M⁻¹ (F − K u) − α v_b) on block `b` of the nodes
+    /// ([`NODE_BLOCK`]; `un` its entries), 0 on held components; with `fused` the block's
+    /// energy increments, else zeros.
+    fn predict_block_into(&self, b: usize, un: &mut [f64], fused: bool) -> [f64; 4] {
+        let (dt, model) = (self.dt, self.model);
+        let dt2 = dt * dt;
+        let first = b * NODE_BLOCK;
+        for (k, unode) in un.chunks_exact_mut(3).enumerate() {
+            let node = first + k;
+            let m = model.mass.inertial[node];
+            let fx = self.held[node];
+            for c in 0..3 {
+                let i = 3 * node + c;
+                if fx & (1 << c) != 0 {
+                    unode[c] = 0.0;
+                    continue;
+                }
+                let vb = (self.u[i] - self.u_prev[i]) / dt;
+                let an = if self.k.dynamic && !model.mass_damped[node] { 0.0 } else { self.k.alpha };
+                let a = (self.f_ext[i] - self.f_int[i]) / m - an * vb;
+                unode[c] = 2.0 * self.u[i] - self.u_prev[i] + dt2 * a;
+            }
+        }
+        if fused { self.increments(3 * first..3 * first + un.len(), un) } else { [0.0; 4] }
+    }
+
+    /// The block nodes again: a = M⁻¹ (F − K u) − α v_b with their full inverse (on free
+    /// components).
+    fn predict_block_nodes_into(&self, u_next: &mut [f64]) {
+        let (dt, model) = (self.dt, self.model);
+        let dt2 = dt * dt;
+        for b in &model.mass.blocks {
+            let node = b.node as usize;
+            let i0 = 3 * node;
+            let f = nalgebra::Vector3::from_fn(|c, _| self.f_ext[i0 + c] - self.f_int[i0 + c]);
+            let a = b.inverse * f;
+            let an = if self.k.dynamic && !model.mass_damped[node] { 0.0 } else { self.k.alpha };
+            for c in 0..3 {
+                let i = i0 + c;
+                u_next[i] = if self.held[node] & (1 << c) != 0 {
+                    0.0
+                } else {
+                    let vb = (self.u[i] - self.u_prev[i]) / dt;
+                    2.0 * self.u[i] - self.u_prev[i] + dt2 * (a[c] - an * vb)
+                };
+            }
+        }
+    }
+
+    /// Mass damping of the added inertia A of the damped block nodes, Δu_c · α A v_b, added
+    /// to `damp` node by node.
+    fn add_block_mass_damping(&self, u_next: &[f64], damp: &mut f64) {
+        let dt = self.dt;
+        for b in self.model.mass.blocks.iter().filter(|b| self.model.mass_damped[b.node as usize]) {
+            let i0 = 3 * b.node as usize;
+            let du = nalgebra::Vector3::from_fn(|c, _| 0.5 * (u_next[i0 + c] - self.u_prev[i0 + c]));
+            let vb = nalgebra::Vector3::from_fn(|c, _| (self.u[i0 + c] - self.u_prev[i0 + c]) / dt);
+            *damp += du.dot(&(b.added * vb)) * self.k.alpha;
+        }
+    }
+}
+
+/// Adds a dynamic step's energy increments (W_ext, D_α, D_β of [`StepTerms::increments`]) and
+/// its contact work to the account.
+fn add_step_energy(e: &mut Energy, sums: [f64; 4], info: &StepInfo) {
+    e.external_work += sums[0];
+    e.mass_damping += sums[1];
+    e.stiffness_damping += sums[2];
+    e.contact_work += info.correction.work;
 }
 
 /// Outcome of gravity equilibration.

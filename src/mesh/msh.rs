@@ -7,9 +7,9 @@
 
 use super::{Cell, CellKind, Group, Mesh};
 use crate::error::MeshError;
-use mshio::mshfile::ElementType;
+use mshio::mshfile::{ElementType, MshFile};
 use std::collections::{BTreeMap, HashMap};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 pub(super) fn read_msh(path: PathBuf) -> Result<Mesh, MeshError> {
     let bytes = crate::files::read_bounded(&path, crate::files::MAX_MESH_INPUT).map_err(|source| MeshError::Io { path: path.clone(), source })?;
@@ -18,50 +18,79 @@ pub(super) fn read_msh(path: PathBuf) -> Result<Mesh, MeshError> {
 
 /// Parse a MSH 4.1 file held in memory; `path` is only used in messages.
 pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
-    let malformed = |reason: String| MeshError::Malformed { path: path.clone(), reason };
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes); // a UTF-8 byte-order mark
-    if !bytes.starts_with(b"$MeshFormat") {
-        return Err(malformed("it does not start with $MeshFormat".into()));
+    check_format_line(bytes, &path)?;
+    let msh = mshio::parse_msh_bytes(bytes).map_err(|e| {
+        let s = e.to_string();
+        malformed(&path, s.lines().take(6).collect::<Vec<_>>().join("; "))
+    })?;
+    if (msh.header.version - 4.1).abs() > 1e-9 {
+        return Err(malformed(&path, format!("version {} (need 4.1)", msh.header.version)));
     }
-    // The version before mshio sees the file, so that MSH 2.2 or 4.0 gets a clear message
-    // instead of a parser dump.
+    let names = physical_names(bytes).map_err(|r| malformed(&path, r))?;
+    let (nodes, node_tags) = read_nodes(bytes, &msh, &path)?;
+    let index_of: HashMap<u64, usize> = node_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+    if index_of.len() != node_tags.len() {
+        return Err(malformed(&path, "duplicate node tags".into()));
+    }
+    let entity_phys = entity_physical_tags(&msh);
+    let (cells, groups) = read_elements(&msh, &path, &index_of, &entity_phys)?;
+    let groups = groups
+        .into_iter()
+        .map(|((dim, tag), cells)| Group {
+            name: names.get(&(dim, tag)).cloned().unwrap_or_else(|| format!("{dim}:{tag}")),
+            dim,
+            tag,
+            cells,
+        })
+        .collect();
+    Ok(Mesh { source: path, nodes, node_tags, cells, groups })
+}
+
+/// The error for a malformed file at `path`.
+fn malformed(path: &Path, reason: String) -> MeshError {
+    MeshError::Malformed { path: path.to_path_buf(), reason }
+}
+
+/// The `$MeshFormat` line is `4.1 0 8` or `4.1 1 8`: checked before mshio sees the file, so
+/// that MSH 2.2 or 4.0 gets a clear message instead of a parser dump.
+fn check_format_line(bytes: &[u8], path: &Path) -> Result<(), MeshError> {
+    if !bytes.starts_with(b"$MeshFormat") {
+        return Err(malformed(path, "it does not start with $MeshFormat".into()));
+    }
     let version_line = bytes[b"$MeshFormat".len()..].split(|&b| b == b'\n').map(|l| String::from_utf8_lossy(l).trim().to_string()).find(|l| !l.is_empty()).unwrap_or_default();
     let version = version_line.split_whitespace().next().unwrap_or("");
     if version != "4.1" {
-        return Err(malformed(format!(
-            "this is MSH {} (the $MeshFormat line reads `{version_line}`); jointquake reads MSH 4.1: re-export it with `gmsh FILE -save -format msh41` or Gmsh's File > Export, version 4.1",
-            if version.is_empty() { "of an unknown version" } else { version }
-        )));
+        return Err(malformed(
+            path,
+            format!(
+                "this is MSH {} (the $MeshFormat line reads `{version_line}`); jointquake reads MSH 4.1: re-export it with `gmsh FILE -save -format msh41` or Gmsh's File > Export, version 4.1",
+                if version.is_empty() { "of an unknown version" } else { version }
+            ),
+        ));
     }
     let fields: Vec<&str> = version_line.split_whitespace().collect();
     if fields.len() != 3 || !matches!(fields[1], "0" | "1") || fields[2] != "8" {
-        return Err(malformed(format!(
-            "the $MeshFormat line reads `{version_line}`; it must be `4.1 0 8` (ASCII) or `4.1 1 8` (binary)"
-        )));
+        return Err(malformed(path, format!("the $MeshFormat line reads `{version_line}`; it must be `4.1 0 8` (ASCII) or `4.1 1 8` (binary)")));
     }
-    let msh = mshio::parse_msh_bytes(bytes).map_err(|e| {
-        let s = e.to_string();
-        malformed(s.lines().take(6).collect::<Vec<_>>().join("; "))
-    })?;
-    if (msh.header.version - 4.1).abs() > 1e-9 {
-        return Err(malformed(format!("version {} (need 4.1)", msh.header.version)));
-    }
-    let names = physical_names(bytes).map_err(malformed)?;
+    Ok(())
+}
 
-    // ---- nodes
-    let nodes_sec = msh.data.nodes.as_ref().ok_or_else(|| malformed("no $Nodes section".into()))?;
+/// The nodes' coordinates [m] and tags in file order, checked finite.
+fn read_nodes(bytes: &[u8], msh: &MshFile<u64, i32, f64>, path: &Path) -> Result<(Vec<[f64; 3]>, Vec<u64>), MeshError> {
+    let nodes_sec = msh.data.nodes.as_ref().ok_or_else(|| malformed(path, "no $Nodes section".into()))?;
     // Capacities from what was parsed, never from a count the file claims.
     let n_parsed: usize = nodes_sec.node_blocks.iter().map(|b| b.nodes.len()).sum();
     if nodes_sec.num_nodes as u128 != n_parsed as u128 {
-        return Err(malformed(format!("the $Nodes header claims {} nodes but its blocks hold {n_parsed}", nodes_sec.num_nodes)));
+        return Err(malformed(path, format!("the $Nodes header claims {} nodes but its blocks hold {n_parsed}", nodes_sec.num_nodes)));
     }
     let mut nodes = Vec::with_capacity(n_parsed);
     let mut node_tags = Vec::with_capacity(n_parsed);
     let file_tags = if nodes_sec.node_blocks.iter().any(|b| b.node_tags.is_none()) {
-        let tags = node_tags_in_file_order(bytes, &msh.header).map_err(malformed)?;
+        let tags = node_tags_in_file_order(bytes, &msh.header).map_err(|r| malformed(path, r))?;
         let n: usize = nodes_sec.node_blocks.iter().map(|b| b.nodes.len()).sum();
         if tags.len() != n {
-            return Err(malformed(format!("$Nodes lists {} node tags for {n} nodes", tags.len())));
+            return Err(malformed(path, format!("$Nodes lists {} node tags for {n} nodes", tags.len())));
         }
         tags
     } else {
@@ -83,18 +112,17 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
         next += block.nodes.len();
         for (n, t) in block.nodes.iter().zip(tags) {
             if !(n.x.is_finite() && n.y.is_finite() && n.z.is_finite()) {
-                return Err(MeshError::NonFiniteNode { path: path.clone(), node: t });
+                return Err(MeshError::NonFiniteNode { path: path.to_path_buf(), node: t });
             }
             nodes.push([n.x, n.y, n.z]);
             node_tags.push(t);
         }
     }
-    let index_of: HashMap<u64, usize> = node_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect();
-    if index_of.len() != node_tags.len() {
-        return Err(malformed("duplicate node tags".into()));
-    }
+    Ok((nodes, node_tags))
+}
 
-    // ---- entities → physical tags
+/// Physical tags of each entity, keyed by (dimension, entity tag).
+fn entity_physical_tags(msh: &MshFile<u64, i32, f64>) -> HashMap<(usize, i32), Vec<i32>> {
     let mut entity_phys: HashMap<(usize, i32), Vec<i32>> = HashMap::new();
     if let Some(ent) = &msh.data.entities {
         for p in &ent.points {
@@ -110,12 +138,21 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
             entity_phys.insert((3, v.tag), v.physical_tags.clone());
         }
     }
+    entity_phys
+}
 
-    // ---- elements
-    let elems = msh.data.elements.as_ref().ok_or_else(|| malformed("no $Elements section".into()))?;
+/// The tet4/hex8/tri3/quad4 cells (points and lines skipped) with their nodes as indices
+/// (`index_of` a node tag), and the cells of each physical group keyed by (dimension, tag).
+fn read_elements(
+    msh: &MshFile<u64, i32, f64>,
+    path: &Path,
+    index_of: &HashMap<u64, usize>,
+    entity_phys: &HashMap<(usize, i32), Vec<i32>>,
+) -> Result<(Vec<Cell>, BTreeMap<(usize, i32), Vec<usize>>), MeshError> {
+    let elems = msh.data.elements.as_ref().ok_or_else(|| malformed(path, "no $Elements section".into()))?;
     let e_parsed: usize = elems.element_blocks.iter().map(|b| b.elements.len()).sum();
     if elems.num_elements as u128 != e_parsed as u128 {
-        return Err(malformed(format!("the $Elements header claims {} elements but its blocks hold {e_parsed}", elems.num_elements)));
+        return Err(malformed(path, format!("the $Elements header claims {} elements but its blocks hold {e_parsed}", elems.num_elements)));
     }
     let mut cells = Vec::new();
     let mut groups: BTreeMap<(usize, i32), Vec<usize>> = BTreeMap::new();
@@ -129,22 +166,18 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
             ElementType::Pnt | ElementType::Lin2 => continue, // points and lines are not used
             other => {
                 let element = block.elements.first().map(|e| e.element_tag).unwrap_or(0);
-                return Err(MeshError::UnsupportedElement {
-                    path: path.clone(),
-                    element,
-                    kind: format!("{other:?}"),
-                });
+                return Err(MeshError::UnsupportedElement { path: path.to_path_buf(), element, kind: format!("{other:?}") });
             }
         };
         let dim = block.entity_dim as usize;
         let phys = entity_phys.get(&(dim, block.entity_tag)).cloned().unwrap_or_default();
         for e in &block.elements {
             if e.nodes.len() != kind.n_nodes() {
-                return Err(malformed(format!("element {} has {} nodes, {:?} needs {}", e.element_tag, e.nodes.len(), kind, kind.n_nodes())));
+                return Err(malformed(path, format!("element {} has {} nodes, {:?} needs {}", e.element_tag, e.nodes.len(), kind, kind.n_nodes())));
             }
             local.clear();
             for &t in &e.nodes {
-                let i = *index_of.get(&t).ok_or(MeshError::MissingNode { path: path.clone(), element: e.element_tag, node: t })?;
+                let i = *index_of.get(&t).ok_or(MeshError::MissingNode { path: path.to_path_buf(), element: e.element_tag, node: t })?;
                 local.push(i);
             }
             let id = cells.len();
@@ -154,16 +187,7 @@ pub fn parse_msh(bytes: &[u8], path: PathBuf) -> Result<Mesh, MeshError> {
             }
         }
     }
-    let groups = groups
-        .into_iter()
-        .map(|((dim, tag), cells)| Group {
-            name: names.get(&(dim, tag)).cloned().unwrap_or_else(|| format!("{dim}:{tag}")),
-            dim,
-            tag,
-            cells,
-        })
-        .collect();
-    Ok(Mesh { source: path, nodes, node_tags, cells, groups })
+    Ok((cells, groups))
 }
 
 /// Node tags of the `$Nodes` section in file order (ASCII or binary MSH 4.1; mshio has

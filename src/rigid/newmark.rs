@@ -374,35 +374,14 @@ fn check_law(model: &SlidingModel) -> Result<(), RigidError> {
 }
 
 fn slide_impl(intact: &SlidingModel, residual: Option<&SlidingModel>, a_h: &[f64], a_v: Option<&[f64]>, opts: &NewmarkOptions) -> Result<NewmarkResult, RigidError> {
-    let dt = super::positive("record time step dt [s]", opts.dt)?;
-    let g = super::positive("g [m/s2]", intact.g)?;
-    check_law(intact)?;
-    if let Some(r) = residual {
-        check_law(r)?;
-    }
-    if a_h.is_empty() {
-        return Err(RigidError::invalid("number of record samples", 0.0, "give at least one sample"));
-    }
-    check_record("horizontal acceleration", a_h)?;
-    if let Some(av) = a_v {
-        if av.len() != a_h.len() {
-            return Err(RigidError::LengthMismatch { expected: a_h.len(), got: av.len() });
-        }
-        check_record("vertical acceleration", av)?;
-    }
-    let k = |i: usize| -> (f64, f64) {
-        if i < a_h.len() { (a_h[i] / g, a_v.map_or(0.0, |av| av[i] / g)) } else { (0.0, 0.0) }
-    };
-    let rates = |m: &SlidingModel, i: usize| {
-        let (kh, kv) = k(i);
-        (m.down.at(kh, kv), m.up.map(|u| u.at(kh, kv)))
-    };
+    let (dt, g) = check_slide_input(intact, residual, a_h, a_v, opts)?;
+    let rec = GroundRecord { a_h, a_v, g };
     // lift-off is checked on the law in force after the bond is lost (if it is lost at all,
     // that is the law of the sliding phase; the normal forces of both laws are the same).
     let model = residual.unwrap_or(intact);
     let lift_off_samples = (0..a_h.len())
         .filter(|&i| {
-            let (kh, kv) = k(i);
+            let (kh, kv) = rec.k(i);
             model.normals.iter().any(|n| n.at(kh, kv) < 0.0)
         })
         .count();
@@ -420,69 +399,18 @@ fn slide_impl(intact: &SlidingModel, residual: Option<&SlidingModel>, a_h: &[f64
             velocity_at_end = s.v;
         }
         match residual {
-            Some(res) if s.n_episodes == 0 => {
-                let (da, ua) = rates(intact, i);
-                let (db, ub) = rates(intact, i + 1);
-                let before = (s.v, s.d, s.mode, s.vmax);
-                s.advance(dt, da, db, ua.zip(ub));
-                if s.n_episodes > 0 {
-                    // The bond broke inside this interval: redo it, intact up to the start
-                    // time t* (at rest), then with the residual law from t*.
-                    (s.v, s.d, s.mode, s.vmax) = before;
-                    s.n_episodes = 0;
-                    s.n_up = 0;
-                    let t_star = |a: f64, b: f64, up: bool| -> Option<f64> {
-                        let (a, b) = if up { (-a, -b) } else { (a, b) };
-                        if a > 0.0 {
-                            Some(0.0)
-                        } else if b > 0.0 {
-                            Some(dt * (-a) / (b - a))
-                        } else {
-                            None
-                        }
-                    };
-                    let ts = [t_star(da, db, false), ua.zip(ub).and_then(|(x, y)| t_star(x, y, true))]
-                        .into_iter()
-                        .flatten()
-                        .fold(dt, f64::min);
-                    let (ra, rua) = rates(res, i);
-                    let (rb, rub) = rates(res, i + 1);
-                    let lerp = |a: f64, b: f64| a + (b - a) * ts / dt;
-                    let up_res = rua.zip(rub).map(|(x, y)| (lerp(x, y), y));
-                    s.advance(dt - ts, lerp(ra, rb), rb, up_res);
-                    if s.n_episodes == 0 {
-                        // round-off at t*: the residual law is weaker, so the block does start
-                        s.n_episodes = 1;
-                    }
-                }
-            }
+            Some(res) if s.n_episodes == 0 => s.advance_bonded(dt, intact, res, &rec, i),
             _ => {
                 let m = if s.n_episodes > 0 { residual.unwrap_or(intact) } else { intact };
-                let (da, ua) = rates(m, i);
-                let (db, ub) = rates(m, i + 1);
+                let (da, ua) = rec.rates(m, i);
+                let (db, ub) = rec.rates(m, i + 1);
                 s.advance(dt, da, db, ua.zip(ub));
             }
         }
     }
     // Free run-out with zero ground acceleration: constant r = c0.
     let model = if s.n_episodes > 0 { residual.unwrap_or(intact) } else { intact };
-    let mut still_sliding = false;
-    match s.mode {
-        Mode::Down if model.down.c0 < 0.0 => {
-            s.d += s.v * s.v / (2.0 * -model.down.c0);
-            s.v = 0.0;
-        }
-        Mode::Up if model.up.is_some_and(|u| u.c0 > 0.0) => {
-            s.d -= s.v * s.v / (2.0 * model.up.map_or(1.0, |u| u.c0));
-            s.v = 0.0;
-        }
-        Mode::Rest => {
-            if model.down.c0 > 0.0 || model.up.is_some_and(|u| u.c0 < 0.0) {
-                still_sliding = true;
-            }
-        }
-        _ => still_sliding = true,
-    }
+    let still_sliding = s.run_out(model);
     Ok(NewmarkResult {
         residual_displacement: s.d,
         max_velocity: s.vmax,
@@ -493,6 +421,110 @@ fn slide_impl(intact: &SlidingModel, residual: Option<&SlidingModel>, a_h: &[f64
         lift_off_samples,
         history,
     })
+}
+
+/// The record step dt [s] and g [m/s²] of a slide, after checking the laws and the records
+/// (finite, at least one sample, the vertical as long as the horizontal).
+fn check_slide_input(intact: &SlidingModel, residual: Option<&SlidingModel>, a_h: &[f64], a_v: Option<&[f64]>, opts: &NewmarkOptions) -> Result<(f64, f64), RigidError> {
+    let dt = super::positive("record time step dt [s]", opts.dt)?;
+    let g = super::positive("g [m/s2]", intact.g)?;
+    check_law(intact)?;
+    if let Some(r) = residual {
+        check_law(r)?;
+    }
+    if a_h.is_empty() {
+        return Err(RigidError::invalid("number of record samples", 0.0, "give at least one sample"));
+    }
+    check_record("horizontal acceleration", a_h)?;
+    if let Some(av) = a_v {
+        if av.len() != a_h.len() {
+            return Err(RigidError::LengthMismatch { expected: a_h.len(), got: av.len() });
+        }
+        check_record("vertical acceleration", av)?;
+    }
+    Ok((dt, g))
+}
+
+/// The ground accelerations of a slide [m/s²] and g [m/s²].
+struct GroundRecord<'a> {
+    a_h: &'a [f64],
+    a_v: Option<&'a [f64]>,
+    g: f64,
+}
+
+impl GroundRecord<'_> {
+    /// (k_h, k_v) = (a_h, a_v) / g at sample `i`; 0 after the record.
+    fn k(&self, i: usize) -> (f64, f64) {
+        if i < self.a_h.len() { (self.a_h[i] / self.g, self.a_v.map_or(0.0, |av| av[i] / self.g)) } else { (0.0, 0.0) }
+    }
+
+    /// The down and (two-way laws) up rates of law `m` at sample `i`.
+    fn rates(&self, m: &SlidingModel, i: usize) -> (f64, Option<f64>) {
+        let (kh, kv) = self.k(i);
+        (m.down.at(kh, kv), m.up.map(|u| u.at(kh, kv)))
+    }
+}
+
+impl Slider {
+    /// Interval `i` (of length `dt`) while the bond holds: with the `intact` law; when the
+    /// block starts inside it, the interval is redone, intact up to the start time t* (at
+    /// rest), then with the `residual` law from t*.
+    fn advance_bonded(&mut self, dt: f64, intact: &SlidingModel, res: &SlidingModel, rec: &GroundRecord, i: usize) {
+        let (da, ua) = rec.rates(intact, i);
+        let (db, ub) = rec.rates(intact, i + 1);
+        let before = (self.v, self.d, self.mode, self.vmax);
+        self.advance(dt, da, db, ua.zip(ub));
+        if self.n_episodes == 0 {
+            return;
+        }
+        // The bond broke inside this interval: redo it.
+        (self.v, self.d, self.mode, self.vmax) = before;
+        self.n_episodes = 0;
+        self.n_up = 0;
+        let t_star = |a: f64, b: f64, up: bool| -> Option<f64> {
+            let (a, b) = if up { (-a, -b) } else { (a, b) };
+            if a > 0.0 {
+                Some(0.0)
+            } else if b > 0.0 {
+                Some(dt * (-a) / (b - a))
+            } else {
+                None
+            }
+        };
+        let ts = [t_star(da, db, false), ua.zip(ub).and_then(|(x, y)| t_star(x, y, true))].into_iter().flatten().fold(dt, f64::min);
+        let (ra, rua) = rec.rates(res, i);
+        let (rb, rub) = rec.rates(res, i + 1);
+        let lerp = |a: f64, b: f64| a + (b - a) * ts / dt;
+        let up_res = rua.zip(rub).map(|(x, y)| (lerp(x, y), y));
+        self.advance(dt - ts, lerp(ra, rb), rb, up_res);
+        if self.n_episodes == 0 {
+            // round-off at t*: the residual law is weaker, so the block does start
+            self.n_episodes = 1;
+        }
+    }
+
+    /// The free run-out after the record under law `model` (zero ground acceleration:
+    /// constant r = c0). Returns whether the block is still sliding (it would never stop).
+    fn run_out(&mut self, model: &SlidingModel) -> bool {
+        let mut still_sliding = false;
+        match self.mode {
+            Mode::Down if model.down.c0 < 0.0 => {
+                self.d += self.v * self.v / (2.0 * -model.down.c0);
+                self.v = 0.0;
+            }
+            Mode::Up if model.up.is_some_and(|u| u.c0 > 0.0) => {
+                self.d -= self.v * self.v / (2.0 * model.up.map_or(1.0, |u| u.c0));
+                self.v = 0.0;
+            }
+            Mode::Rest => {
+                if model.down.c0 > 0.0 || model.up.is_some_and(|u| u.c0 < 0.0) {
+                    still_sliding = true;
+                }
+            }
+            _ => still_sliding = true,
+        }
+        still_sliding
+    }
 }
 
 /// Newmark sliding of a block on an incline; `a_h` positive into the hill, `a_v` up [m/s²].

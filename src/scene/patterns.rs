@@ -18,7 +18,7 @@
 
 use crate::mesh::pattern::{binding_text, fill_text, is_pattern, GroupPattern, PatternError};
 use crate::mesh::Mesh;
-use crate::scene::Scene;
+use crate::scene::{JointSceneSpec, Scene};
 use serde::Serialize;
 
 /// One pattern that was expanded: where it was, what it said, how many entries it became.
@@ -92,47 +92,10 @@ impl Scene {
     /// was expanded (empty for a scene without patterns, which is left unchanged).
     pub fn expand_group_patterns(&mut self, groups: &[(String, usize)]) -> Result<Vec<PatternUse>, PatternError> {
         let mut uses = Vec::new();
-
         // materials: one entry per matched volume group
-        if self.materials.iter().any(|m| is_pattern(&m.group)) {
-            let mut out = Vec::new();
-            for (i, m) in self.materials.iter().enumerate() {
-                if is_pattern(&m.group) {
-                    let field = format!("materials[{i}].group");
-                    let e = expand_one(&field, &m.group, groups, Some(3))?;
-                    for g in &e {
-                        let mut c = m.clone();
-                        c.group = g.clone();
-                        out.push(c);
-                    }
-                    uses.push(PatternUse { field, pattern: m.group.clone(), expanded: e });
-                } else {
-                    out.push(m.clone());
-                }
-            }
-            self.materials = out;
-        }
-
+        expand_entries("materials", &mut self.materials, |m| &mut m.group, groups, Some(3), &mut uses)?;
         // boundary: one entry per matched group of any dimension
-        if self.boundary.iter().any(|b| is_pattern(&b.group)) {
-            let mut out = Vec::new();
-            for (i, b) in self.boundary.iter().enumerate() {
-                if is_pattern(&b.group) {
-                    let field = format!("boundary[{i}].group");
-                    let e = expand_one(&field, &b.group, groups, None)?;
-                    for g in &e {
-                        let mut c = b.clone();
-                        c.group = g.clone();
-                        out.push(c);
-                    }
-                    uses.push(PatternUse { field, pattern: b.group.clone(), expanded: e });
-                } else {
-                    out.push(b.clone());
-                }
-            }
-            self.boundary = out;
-        }
-
+        expand_entries("boundary", &mut self.boundary, |b| &mut b.group, groups, None, &mut uses)?;
         if let Some(g) = self.loads.gravity.as_mut() {
             if let Some(list) = g.groups.as_mut() {
                 expand_list("loads.gravity.groups", list, groups, Some(3), &mut uses)?;
@@ -141,7 +104,6 @@ impl Scene {
         if let Some(list) = self.damping.mass_groups.as_mut() {
             expand_list("damping.mass_groups", list, groups, Some(3), &mut uses)?;
         }
-
         // joints: master matched, slave (and name) filled in from the captures
         if self.joints.iter().any(|j| is_pattern(&j.master) || is_pattern(&j.slave)) {
             let faces = names_of_dim(groups, Some(2));
@@ -152,64 +114,106 @@ impl Scene {
                     continue;
                 }
                 let field = format!("joints[{i}]");
-                let mp = GroupPattern::parse(&j.master)?;
-                let sp = GroupPattern::parse(&j.slave)?;
-                let (mut a, mut b) = (mp.placeholders(), sp.placeholders());
-                a.sort();
-                b.sort();
-                if a != b || a.is_empty() {
-                    return Err(PatternError::PlaceholderMismatch {
-                        field: format!("{field} (master/slave)"),
-                        pattern: j.master.clone(),
-                        other: j.slave.clone(),
-                        found: a,
-                        other_found: b,
-                    });
-                }
-                let m = mp.matches(faces.iter().copied())?;
-                if m.is_empty() {
-                    return Err(PatternError::NoMatch {
-                        field: format!("{field}.master"),
-                        pattern: j.master.clone(),
-                        what: what(Some(2)),
-                        available: faces.iter().map(|s| s.to_string()).collect(),
-                    });
-                }
-                if m.len() > 1 && !j.name.contains('{') {
-                    let example = format!("{}{}", j.name, mp.placeholders().iter().map(|p| format!("{{{p}}}")).collect::<String>());
-                    return Err(PatternError::NameCollision { field: format!("{field}.name"), pattern: j.master.clone(), count: m.len(), name: j.name.clone(), example });
-                }
-                let mut names = Vec::with_capacity(m.len());
-                for (master, bind) in &m {
-                    let slave = sp.instantiate(bind)?;
-                    if !faces.contains(&slave.as_str()) {
-                        return Err(PatternError::MissingPartner {
-                            field: format!("{field}.slave"),
-                            pattern: j.master.clone(),
-                            matched: master.clone(),
-                            binding: binding_text(bind),
-                            partner_pattern: j.slave.clone(),
-                            partner: slave,
-                            what: what(Some(2)),
-                        });
-                    }
-                    let name = fill_text(&j.name, bind).map_err(|missing| PatternError::UnknownPlaceholder {
-                        field: format!("{field}.name"),
-                        text: j.name.clone(),
-                        name: missing,
-                        pattern: j.master.clone(),
-                    })?;
-                    let mut c = j.clone();
-                    c.master = master.clone();
-                    c.slave = slave;
-                    c.name = name.clone();
-                    names.push(name);
-                    out.push(c);
-                }
+                let names = expand_joint_into(&field, j, &faces, &mut out)?;
                 uses.push(PatternUse { field: format!("{field}.master"), pattern: j.master.clone(), expanded: names });
             }
             self.joints = out;
         }
         Ok(uses)
     }
+}
+
+/// Expand the entries of section `section` (`materials`, `boundary`) whose group (`group` of
+/// an entry) is a pattern into one entry per matched group of dimension `dim`, the entry
+/// copied; entries without pattern stay as they are.
+fn expand_entries<T: Clone>(
+    section: &str,
+    entries: &mut Vec<T>,
+    group: fn(&mut T) -> &mut String,
+    groups: &[(String, usize)],
+    dim: Option<usize>,
+    uses: &mut Vec<PatternUse>,
+) -> Result<(), PatternError> {
+    if !entries.iter_mut().any(|e| is_pattern(group(e))) {
+        return Ok(());
+    }
+    let mut out = Vec::new();
+    for (i, m) in entries.iter_mut().enumerate() {
+        let pattern = group(m).clone();
+        if is_pattern(&pattern) {
+            let field = format!("{section}[{i}].group");
+            let e = expand_one(&field, &pattern, groups, dim)?;
+            for g in &e {
+                let mut c = m.clone();
+                *group(&mut c) = g.clone();
+                out.push(c);
+            }
+            uses.push(PatternUse { field, pattern, expanded: e });
+        } else {
+            out.push(m.clone());
+        }
+    }
+    *entries = out;
+    Ok(())
+}
+
+/// The joints of the pattern entry `j` (at `field`, e.g. `joints[0]`) appended to `out`: its
+/// master matched against the face groups `faces`, its slave and name filled in from each
+/// match. Returns the joints' names.
+fn expand_joint_into(field: &str, j: &JointSceneSpec, faces: &[&str], out: &mut Vec<JointSceneSpec>) -> Result<Vec<String>, PatternError> {
+    let mp = GroupPattern::parse(&j.master)?;
+    let sp = GroupPattern::parse(&j.slave)?;
+    let (mut a, mut b) = (mp.placeholders(), sp.placeholders());
+    a.sort();
+    b.sort();
+    if a != b || a.is_empty() {
+        return Err(PatternError::PlaceholderMismatch {
+            field: format!("{field} (master/slave)"),
+            pattern: j.master.clone(),
+            other: j.slave.clone(),
+            found: a,
+            other_found: b,
+        });
+    }
+    let m = mp.matches(faces.iter().copied())?;
+    if m.is_empty() {
+        return Err(PatternError::NoMatch {
+            field: format!("{field}.master"),
+            pattern: j.master.clone(),
+            what: what(Some(2)),
+            available: faces.iter().map(|s| s.to_string()).collect(),
+        });
+    }
+    if m.len() > 1 && !j.name.contains('{') {
+        let example = format!("{}{}", j.name, mp.placeholders().iter().map(|p| format!("{{{p}}}")).collect::<String>());
+        return Err(PatternError::NameCollision { field: format!("{field}.name"), pattern: j.master.clone(), count: m.len(), name: j.name.clone(), example });
+    }
+    let mut names = Vec::with_capacity(m.len());
+    for (master, bind) in &m {
+        let slave = sp.instantiate(bind)?;
+        if !faces.contains(&slave.as_str()) {
+            return Err(PatternError::MissingPartner {
+                field: format!("{field}.slave"),
+                pattern: j.master.clone(),
+                matched: master.clone(),
+                binding: binding_text(bind),
+                partner_pattern: j.slave.clone(),
+                partner: slave,
+                what: what(Some(2)),
+            });
+        }
+        let name = fill_text(&j.name, bind).map_err(|missing| PatternError::UnknownPlaceholder {
+            field: format!("{field}.name"),
+            text: j.name.clone(),
+            name: missing,
+            pattern: j.master.clone(),
+        })?;
+        let mut c = j.clone();
+        c.master = master.clone();
+        c.slave = slave;
+        c.name = name.clone();
+        names.push(name);
+        out.push(c);
+    }
+    Ok(names)
 }

@@ -371,7 +371,22 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let k0 = t.reduce(&k_full);
     let f0 = t.reduce_vector(f);
     let mut info = StaticContactInfo::default();
-    // the pairs
+    let mut pairs = active_pairs(problem, &t, &k_full, penalty_factor, &mut info)?;
+    let residual = Residual { k0: &k0, f0: &f0, joints: &problem.joints, nf: norm(&f0) };
+    let uh = newton(&residual, &mut pairs, t.n, &mut info)?;
+    // the result and the pairs' records
+    let mut du = vec![0.0; t.n_dofs];
+    t.expand_into(&uh, &mut du);
+    info.max_displacement = (0..model.n_nodes()).map(|n| Vector3::new(du[3 * n], du[3 * n + 1], du[3 * n + 2]).norm()).fold(0.0, f64::max);
+    record_pairs_into(problem, &pairs, &uh, contact, &mut info);
+    Ok((du, info))
+}
+
+/// The pairs of the joints that are not tied, with their relative motion over the reduced
+/// unknowns of `t` and their penalty (`penalty_factor` × the slave node's mean diagonal of
+/// `k_full`); counts the pairs on tied nodes and those left out into `info`.
+fn active_pairs(problem: &Problem, t: &Bonding, k_full: &Csc, penalty_factor: f64, info: &mut StaticContactInfo) -> Result<Vec<Pair>, Error> {
+    let model = &problem.model;
     let mut pairs = Vec::new();
     let unformed = crate::contact::joint::unformed_pairs(&problem.joints);
     for (ji, j) in problem.joints.iter().enumerate() {
@@ -394,34 +409,56 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
                     (m, _) => m,
                 },
             };
-            let mut w: [Vec<(usize, f64)>; 3] = Default::default();
-            for (c, wc) in w.iter_mut().enumerate() {
-                let mut add = |d: usize, scale: f64| {
-                    for &(r, v) in &t.rows[d] {
-                        match wc.iter_mut().find(|e| e.0 == r) {
-                            Some(e) => e.1 += scale * v,
-                            None => wc.push((r, scale * v)),
-                        }
-                    }
-                };
-                for &(m, nw) in &masters {
-                    add(3 * m + c, nw);
-                }
-                add(3 * s + c, -1.0);
-                wc.retain(|e| e.1 != 0.0);
-            }
+            let w = pair_motion_weights(t, &masters, s);
             let diag = (0..3).map(|c| k_full.get(3 * s + c, 3 * s + c)).sum::<f64>() / 3.0;
             pairs.push(Pair { joint: ji, index: i, w, n: j.frames[i][0], k: penalty_factor * diag, area: j.tag.areas[i], closed: true, changes: 0 });
         }
     }
-    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let nf = norm(&f0);
-    let mut uh = vec![0.0; t.n];
-    // R(u) = F − K u − Σ Bᵀ q into `r`, each pair's state and tangent into `tangents` when
-    // asked, and each pair's closed flag
-    let evaluate = |uh: &[f64], pairs: &[Pair], r: &mut Vec<f64>, tangents: Option<&mut Vec<PairTangent>>, closed: &mut Vec<bool>| {
-        k0.mul_into(uh, r);
-        for (ri, fi) in r.iter_mut().zip(&f0) {
+    Ok(pairs)
+}
+
+/// w_c = Σ_I N_I u_I,c − u_s,c over the reduced unknowns of `t` (the masters `(node, N_I)`,
+/// the slave node `s`), zero weights dropped.
+fn pair_motion_weights(t: &Bonding, masters: &[(usize, f64)], s: usize) -> [Vec<(usize, f64)>; 3] {
+    let mut w: [Vec<(usize, f64)>; 3] = Default::default();
+    for (c, wc) in w.iter_mut().enumerate() {
+        let mut add = |d: usize, scale: f64| {
+            for &(r, v) in &t.rows[d] {
+                match wc.iter_mut().find(|e| e.0 == r) {
+                    Some(e) => e.1 += scale * v,
+                    None => wc.push((r, scale * v)),
+                }
+            }
+        };
+        for &(m, nw) in masters {
+            add(3 * m + c, nw);
+        }
+        add(3 * s + c, -1.0);
+        wc.retain(|e| e.1 != 0.0);
+    }
+    w
+}
+
+/// The Euclidean norm.
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+/// The out-of-balance force of the reduced model: K̂ `k0`, the reduced load `f0` and its norm
+/// `nf`, the joints' laws.
+struct Residual<'a> {
+    k0: &'a Csc,
+    f0: &'a [f64],
+    joints: &'a [ContactJoint],
+    nf: f64,
+}
+
+impl Residual<'_> {
+    /// R(u) = F − K u − Σ Bᵀ q into `r`, each pair's state and tangent into `tangents` when
+    /// asked, and each pair's closed flag; returns ‖R‖ / ‖F‖ (0 without load).
+    fn evaluate_into(&self, uh: &[f64], pairs: &[Pair], r: &mut Vec<f64>, tangents: Option<&mut Vec<PairTangent>>, closed: &mut Vec<bool>) -> f64 {
+        self.k0.mul_into(uh, r);
+        for (ri, fi) in r.iter_mut().zip(self.f0) {
             *ri = fi - *ri;
         }
         closed.clear();
@@ -431,7 +468,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
         }
         for p in pairs {
             let w = relative_motion(p, uh);
-            let (state, q, tangent) = pair_force(p, &w, &problem.joints[p.joint].law, p.changes >= CHATTER_CHANGES);
+            let (state, q, tangent) = pair_force(p, &w, &self.joints[p.joint].law, p.changes >= CHATTER_CHANGES);
             closed.push(state != PairState::Open);
             for (c, wc) in p.w.iter().enumerate() {
                 for &(a, va) in wc {
@@ -442,15 +479,23 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
                 t.push(tangent);
             }
         }
-        if nf > 0.0 { norm(r) / nf } else { 0.0 }
-    };
-    let (mut r, mut r_try) = (vec![0.0; t.n], vec![0.0; t.n]);
+        if self.nf > 0.0 { norm(r) / self.nf } else { 0.0 }
+    }
+}
+
+/// Newton's iteration on the `n` reduced unknowns from 0, with a backtracking line search;
+/// counts each pair's state changes, writes the iterations, residual and solver statistics
+/// into `info`. Returns the reduced solution.
+fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, info: &mut StaticContactInfo) -> Result<Vec<f64>, Error> {
+    let k0 = residual.k0;
+    let mut uh = vec![0.0; n];
+    let (mut r, mut r_try) = (vec![0.0; n], vec![0.0; n]);
     let (mut closed, mut closed_try) = (Vec::new(), Vec::new());
     let mut tangents = Vec::with_capacity(pairs.len());
-    let mut u_try = vec![0.0; t.n];
-    let mut solver = TangentSolver::new(&k0, &pairs);
+    let mut u_try = vec![0.0; n];
+    let mut solver = TangentSolver::new(k0, pairs);
     for it in 0..=MAX_ITERATIONS {
-        info.residual = evaluate(&uh, &pairs, &mut r, Some(&mut tangents), &mut closed);
+        info.residual = residual.evaluate_into(&uh, pairs, &mut r, Some(&mut tangents), &mut closed);
         info.iterations = it;
         for (p, &c) in pairs.iter_mut().zip(&closed) {
             if c != p.closed {
@@ -462,14 +507,14 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
             info.converged = info.residual < TOLERANCE;
             break;
         }
-        solver.direction_in_place(&k0, &pairs, &tangents, &mut r)?;
+        solver.direction_in_place(k0, pairs, &tangents, &mut r)?;
         // backtracking line search on ‖R‖ (Armijo, halving): the law is only piecewise smooth
         let mut step = 1.0;
         for _ in 0..LINE_SEARCH_HALVINGS {
             for ((ut, u), d) in u_try.iter_mut().zip(&uh).zip(&r) {
                 *ut = u + step * d;
             }
-            let res = evaluate(&u_try, &pairs, &mut r_try, None, &mut closed_try);
+            let res = residual.evaluate_into(&u_try, pairs, &mut r_try, None, &mut closed_try);
             if res <= (1.0 - 1e-4 * step) * info.residual {
                 break;
             }
@@ -478,13 +523,16 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
         uh.copy_from_slice(&u_try);
     }
     info.solver = solver.stats;
-    // the result and the pairs' records
-    let mut du = vec![0.0; t.n_dofs];
-    t.expand_into(&uh, &mut du);
-    info.max_displacement = (0..model.n_nodes()).map(|n| Vector3::new(du[3 * n], du[3 * n + 1], du[3 * n + 2]).norm()).fold(0.0, f64::max);
+    Ok(uh)
+}
+
+/// Each pair's state, gap and forces at the reduced solution `uh` into `contact` (cohesion
+/// lost where it slid or opened, unless kept), and the pair counts, largest penetration,
+/// normal force and condition violation into `info`.
+fn record_pairs_into(problem: &Problem, pairs: &[Pair], uh: &[f64], contact: &mut ContactState, info: &mut StaticContactInfo) {
     let mut tension = 0.0f64;
-    for p in &pairs {
-        let w = relative_motion(p, &uh);
+    for p in pairs {
+        let w = relative_motion(p, uh);
         let j = &problem.joints[p.joint];
         let held = p.changes >= CHATTER_CHANGES;
         let (state, q, _) = pair_force(p, &w, &j.law, held);
@@ -515,5 +563,4 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
         }
     }
     info.condition_violation = if info.max_normal_force > 0.0 { tension.max(0.0) / info.max_normal_force } else { 0.0 };
-    Ok((du, info))
 }

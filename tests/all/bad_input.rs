@@ -1,7 +1,7 @@
 //! Bad input through the library (`pipeline::run`, `pipeline::tag`): every error must NAME the
 //! culprit (key, group, file, element, line, value) and say what to fix. Scenes are written into
 //! scratch directories and point at the committed fixtures by absolute path.
-use crate::common::{assert_mentions, fixture, run_error_at, scratch};
+use crate::common::{assert_mentions, column_scene, fixture, run_error_at, scratch, write_scene_in};
 use jointquake::mesh::Mesh;
 use jointquake::model::Model;
 use jointquake::pipeline::{run, tag, RunOptions};
@@ -9,23 +9,9 @@ use jointquake::scene::Scene;
 use serde_json::{json, Value};
 use std::path::PathBuf;
 
-/// Write `scene` as `<scratch(test)>/scene.json`; returns (scene path, scratch dir).
+/// Write `scene` as `<scratch(bad_input/test)>/scene.json`; returns (scene path, scratch dir).
 fn write_scene(test: &str, scene: &Value) -> (PathBuf, PathBuf) {
-    let dir = scratch(&format!("bad_input/{test}"));
-    let p = dir.join("scene.json");
-    std::fs::write(&p, serde_json::to_string_pretty(scene).unwrap()).unwrap();
-    (p, dir)
-}
-
-/// A small valid scene on the 10-hex column fixture; tests break one thing in it.
-fn column_scene() -> Value {
-    json!({
-        "geometry": {"msh": fixture("column_hex.msh")},
-        "materials": [{"group": "block:column", "E": 30e9, "nu": 0.2, "rho": 2400}],
-        "boundary": [{"group": "bc:base"}],
-        "time": {"duration": 0.001},
-        "output": {"frames": false}
-    })
+    write_scene_in(&format!("bad_input/{test}"), scene)
 }
 
 /// The error message of `run` on `scene` (which must fail).

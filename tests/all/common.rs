@@ -89,3 +89,100 @@ pub fn assert_mentions(msg: &str, parts: &[&str]) {
         assert!(msg.contains(p), "message does not mention {p:?}:\n{msg}");
     }
 }
+
+/// Build and run the generated joint test `v` (`jointquake testcase`, src/testcase), print its
+/// errors, and for a patch assert that its static solve converged (residual below 1e-10).
+pub fn testcase(v: serde_json::Value) -> jointquake::testcase::run::CaseResult {
+    use jointquake::testcase::run::{run_case, Errors};
+    let spec: jointquake::testcase::CaseSpec = serde_json::from_value(v.clone()).expect("case spec");
+    let c = jointquake::testcase::build(&spec).expect("case builds");
+    let r = run_case(&c).expect("case runs");
+    println!("{v}: error {:.4e} ({}), {:?}, lost {}", r.error, r.error_of, r.errors, r.lost);
+    if let Errors::Patch { converged, residual, .. } = &r.errors {
+        assert!(*converged && *residual < 1e-10, "{v}: static solve not converged ({residual:.2e})");
+    }
+    r
+}
+
+/// A patch test's errors: σ next to the joint, the contact pressure inside, the shear.
+pub fn patch_errors(r: &jointquake::testcase::run::CaseResult) -> (f64, f64, f64) {
+    match &r.errors {
+        jointquake::testcase::run::Errors::Patch { stress_joint, pressure_interior, shear, .. } => (*stress_joint, *pressure_interior, *shear),
+        e => panic!("not a patch: {e:?}"),
+    }
+}
+
+/// A record file `ramp.txt` in `dir`: the acceleration ramps linearly from 0 to `a_g` [g]
+/// over `ramp` s, then holds, to `end` s (401 samples).
+pub fn ramp_record(dir: &std::path::Path, a_g: f64, ramp: f64, end: f64) -> PathBuf {
+    let p = dir.join("ramp.txt");
+    let mut s = String::from("# t [s], a [g]\n");
+    let n = 400;
+    for i in 0..=n {
+        let t = end * i as f64 / n as f64;
+        s.push_str(&format!("{t} {}\n", a_g * (t / ramp).min(1.0)));
+    }
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+/// The base-shear test's set-up (Westergaard's added mass, dam_physics.rs and reservoir.rs):
+/// the stiff block `block:b` (2 × 3 × 10 m of `mesh`, E = 10⁵ GPa, fixed at `b:z0`) with the
+/// reservoir section `reservoir`, shaken along x by a ramp to 0.2 g over 0.2 s (scratch
+/// directory `test`), run to 0.3 s (0.9 × the stable step). Returns the base shear V [N] (the
+/// reaction Σ (K u)_x over the fixed base nodes plus their inertia, which moves with the
+/// ground), the model's total inertial mass [kg], the ground acceleration a [m/s²] and the
+/// problem.
+pub fn stiff_block_base_shear(test: &str, mesh: Mesh, reservoir: serde_json::Value) -> (f64, f64, f64, Problem) {
+    let dir = scratch(test);
+    let rec = ramp_record(&dir, 0.2, 0.2, 0.5);
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [{"group": "block:b", "E": 1e14, "nu": 0.2, "rho": 2400.0}],
+        "boundary": [{"group": "b:z0"}],
+        "loads": {"base": [{"record": rec, "direction": [1.0, 0.0, 0.0]}]},
+        "damping": {"alpha": 20.0},
+        "reservoir": reservoir,
+        "time": {"duration": 0.3}
+    }));
+    let pb = problem(mesh, &sc, 0.9);
+    let model = &pb.model;
+    let mut sim = Simulation::new(&pb).unwrap();
+    let n_steps = sim.n_steps();
+    for _ in 0..n_steps {
+        sim.step().unwrap();
+    }
+    let mut ku = vec![0.0; 3 * model.n_nodes()];
+    model.internal_forces_into(&sim.state.u, &mut ku);
+    let a = 0.2 * 9.81;
+    let base = model.mesh.group_nodes("b:z0").unwrap();
+    // reaction on the structure at the base = −Σ (K u)_x there; plus the base nodes' inertia
+    let mut v = 0.0;
+    for &nd in &base {
+        v += ku[3 * nd];
+        v += model.mass.apply(nd, &nalgebra::Vector3::new(a, 0.0, 0.0))[0];
+    }
+    let m_total: f64 = model.mass.inertial.iter().sum();
+    drop(sim);
+    (v, m_total, a, pb)
+}
+
+/// A small valid scene on the 10-hex column fixture (it runs; the hardening and bad-input tests
+/// break one thing in it).
+pub fn column_scene() -> serde_json::Value {
+    serde_json::json!({
+        "geometry": {"msh": fixture("column_hex.msh")},
+        "materials": [{"group": "block:column", "E": 30e9, "nu": 0.2, "rho": 2400}],
+        "boundary": [{"group": "bc:base"}],
+        "time": {"duration": 0.001},
+        "output": {"frames": false}
+    })
+}
+
+/// Write `scene` as `<scratch(dir)>/scene.json`; returns (scene path, scratch dir).
+pub fn write_scene_in(dir: &str, scene: &serde_json::Value) -> (PathBuf, PathBuf) {
+    let dir = scratch(dir);
+    let p = dir.join("scene.json");
+    std::fs::write(&p, serde_json::to_string_pretty(scene).unwrap()).unwrap();
+    (p, dir)
+}

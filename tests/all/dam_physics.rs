@@ -1,7 +1,7 @@
 //! Dam physics: massless foundation (static condensation), reservoir (hydrostatic, added mass),
 //! natural frequencies (docs/dam_physics.md). Each test states its reference and tolerance.
 
-use crate::common::{problem, scene, scratch};
+use crate::common::{problem, scene, scratch, stiff_block_base_shear};
 use jointquake::linalg::{dof_map, lowest_modes, mass_matrix, restrict, stiffness, ModesOptions, NONE};
 use jointquake::mesh::structured::{box_mesh, BoxSpec};
 use jointquake::mesh::{Group, Mesh};
@@ -172,19 +172,6 @@ fn block_on_a_massless_foundation_first_frequency_equals_the_dense_condensation(
     assert_eq!(model.critical.group, "block:dam");
 }
 
-/// A record file: linear ramp of the acceleration from 0 to `a_g` [g] over `ramp` s, then held.
-fn ramp_record(dir: &std::path::Path, a_g: f64, ramp: f64, end: f64) -> std::path::PathBuf {
-    let p = dir.join("ramp.txt");
-    let mut s = String::from("# t [s], a [g]\n");
-    let n = 400;
-    for i in 0..=n {
-        let t = end * i as f64 / n as f64;
-        s.push_str(&format!("{t} {}\n", a_g * (t / ramp).min(1.0)));
-    }
-    std::fs::write(&p, s).unwrap();
-    p
-}
-
 #[test]
 fn base_shear_of_a_stiff_block_with_a_wet_face_includes_the_westergaard_mass() {
     // Reference: quasi-static rigid response to a uniform base acceleration a along x (the wet
@@ -194,36 +181,9 @@ fn base_shear_of_a_stiff_block_with_a_wet_face_includes_the_westergaard_mass() {
     // move with the ground. Block 2 × 3 × 10 m, E = 10⁵ GPa (stiff: f1 ≈ 400 Hz), the record
     // ramps to 0.2 g over 0.2 s and holds; V read at 0.3 s. Tolerance 1 % (the nodal added mass
     // sum is −0.3 % low at 20 nodes over H; hydrostatic off, so V has no static part).
-    let dir = scratch("dam_base_shear");
-    let rec = ramp_record(&dir, 0.2, 0.2, 0.5);
     let mesh = box_mesh(&BoxSpec::new("b", [2.0, 3.0, 10.0], [2, 3, 20]));
-    let sc = scene(serde_json::json!({
-        "geometry": {"msh": "none.msh"},
-        "materials": [{"group": "block:b", "E": 1e14, "nu": 0.2, "rho": 2400.0}],
-        "boundary": [{"group": "b:z0"}],
-        "loads": {"base": [{"record": rec, "direction": [1.0, 0.0, 0.0]}]},
-        "damping": {"alpha": 20.0},
-        "reservoir": {"faces": ["b:x0"], "level": 10.0, "hydrostatic": false},
-        "time": {"duration": 0.3}
-    }));
-    let pb = problem(mesh, &sc, 0.9);
-    let model = &pb.model;
-    let mut sim = Simulation::new(&pb).unwrap();
-    let n_steps = sim.n_steps();
-    for _ in 0..n_steps {
-        sim.step().unwrap();
-    }
-    let mut ku = vec![0.0; 3 * model.n_nodes()];
-    model.internal_forces_into(&sim.state.u, &mut ku);
-    let a = 0.2 * 9.81;
-    let base = model.mesh.group_nodes("b:z0").unwrap();
-    // reaction on the structure at the base = −Σ (K u)_x there; plus the base nodes' inertia
-    let mut v = 0.0;
-    for &nd in &base {
-        v += ku[3 * nd];
-        v += model.mass.apply(nd, &nalgebra::Vector3::new(a, 0.0, 0.0))[0];
-    }
-    let m_total: f64 = model.mass.inertial.iter().sum();
+    let reservoir = serde_json::json!({"faces": ["b:x0"], "level": 10.0, "hydrostatic": false});
+    let (v, m_total, a, _) = stiff_block_base_shear("dam_base_shear", mesh, reservoir);
     let expect = (m_total + 7.0 / 12.0 * 1000.0 * 100.0 * 3.0) * a;
     let dry = m_total * a;
     println!("wet base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), dry {dry:.5e} N", 100.0 * (v / expect - 1.0));

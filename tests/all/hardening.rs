@@ -1,21 +1,10 @@
 //! Hardening, third round (issues 33 and 34): one regression test per class of hostile input,
 //! named after it. Each either checks the clear error (naming the field, the value and the
 //! limit) or that what is written stays where it belongs.
-use crate::common::{assert_mentions, fixture, run_error_at, scratch};
+use crate::common::{assert_mentions, column_scene, fixture, run_error_at, scratch, write_scene_in};
 use jointquake::pipeline::{run, RunOptions};
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
-
-/// The 10-hex column scene of bad_input.rs (it runs; each test breaks one thing).
-fn column_scene() -> Value {
-    json!({
-        "geometry": {"msh": fixture("column_hex.msh")},
-        "materials": [{"group": "block:column", "E": 30e9, "nu": 0.2, "rho": 2400}],
-        "boundary": [{"group": "bc:base"}],
-        "time": {"duration": 0.001},
-        "output": {"frames": false}
-    })
-}
 
 /// The two 4x3 boxes with one joint `J` (runs in a few steps).
 fn boxes_scene() -> Value {
@@ -32,13 +21,12 @@ fn boxes_scene() -> Value {
     })
 }
 
+/// Write `scene` as `<scratch(hardening/test)>/scene.json`; returns (scene path, scratch dir).
 fn write_scene(test: &str, scene: &Value) -> (PathBuf, PathBuf) {
-    let dir = scratch(&format!("hardening/{test}"));
-    let p = dir.join("scene.json");
-    std::fs::write(&p, serde_json::to_string_pretty(scene).unwrap()).unwrap();
-    (p, dir)
+    write_scene_in(&format!("hardening/{test}"), scene)
 }
 
+/// The error message of `run` on `scene` (which must fail).
 fn run_error(test: &str, scene: &Value) -> String {
     let (p, dir) = write_scene(test, scene);
     run_error_at(test, &p, &dir)

@@ -5,27 +5,9 @@
 //! slave node; ν = 0; src/testcase/mod.rs). Mortar integrates the constraint exactly over the
 //! overlaps (degree-5 rule, exact for the parallelogram faces of these meshes), so the patch
 //! test passes to the round-off of the static solve (it stops at ‖M a‖/‖F‖ < 1e-10).
-use jointquake::testcase::run::{run_case, CaseResult, Errors};
-use jointquake::testcase::{build, CaseSpec};
+use crate::common::{patch_errors, testcase as case};
+use jointquake::testcase::run::Errors;
 use serde_json::json;
-
-fn case(v: serde_json::Value) -> CaseResult {
-    let spec: CaseSpec = serde_json::from_value(v.clone()).expect("case spec");
-    let c = build(&spec).expect("case builds");
-    let r = run_case(&c).expect("case runs");
-    println!("{v}: error {:.4e} ({}), {:?}, lost {}", r.error, r.error_of, r.errors, r.lost);
-    if let Errors::Patch { converged, residual, .. } = &r.errors {
-        assert!(*converged && *residual < 1e-10, "{v}: static solve not converged ({residual:.2e})");
-    }
-    r
-}
-
-fn patch_errors(r: &CaseResult) -> (f64, f64, f64) {
-    match &r.errors {
-        Errors::Patch { stress_joint, pressure_interior, shear, .. } => (*stress_joint, *pressure_interior, *shear),
-        e => panic!("not a patch: {e:?}"),
-    }
-}
 
 /// The flat patch test, pressure only, on the matrix's non-conforming pairs, either side slave.
 /// Bound: 1e-6 relative on σ next to the joint and on the contact pressure (issue 31).

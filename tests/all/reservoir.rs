@@ -2,7 +2,7 @@
 //! volume against Westergaard's exact series, the non-conforming wet-face transfer, and the
 //! model's use in `modes`. Structured box meshes (no gmsh).
 
-use crate::common::{problem, scene};
+use crate::common::{problem, scene, stiff_block_base_shear};
 use jointquake::mesh::structured::{add_box, box_mesh, BoxSpec};
 use jointquake::mesh::Mesh;
 use jointquake::problem::reservoir::incompressible::IncompressibleReservoir;
@@ -221,40 +221,11 @@ fn base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass() {
     // (block 2 × 3 × 10 m, E = 10⁵ GPa, ramp to 0.2 g over 0.2 s, V at 0.3 s) with the water
     // meshed (3H long, hex8 36 × 2 × 18, non-conforming with the block's 3 × 20 face).
     // Tolerance 1 % (the FE resultant is −0.2 % at this water mesh, the rigid-wall test).
-    let dir = crate::common::scratch("reservoir_fe_base_shear");
-    let rec = dir.join("ramp.txt");
-    let mut txt = String::from("# t [s], a [g]\n");
-    for i in 0..=400 {
-        let t = 0.5 * i as f64 / 400.0;
-        txt.push_str(&format!("{t} {}\n", 0.2 * (t / 0.2f64).min(1.0)));
-    }
-    std::fs::write(&rec, txt).unwrap();
     let mut mesh = box_mesh(&BoxSpec::new("b", [2.0, 3.0, 10.0], [2, 3, 20]));
     add_box(&mut mesh, &BoxSpec::new("water", [30.0, 3.0, 10.0], [36, 2, 18]).at([-30.0, 0.0, 0.0]));
-    let sc = scene(serde_json::json!({
-        "geometry": {"msh": "none.msh"},
-        "materials": [{"group": "block:b", "E": 1e14, "nu": 0.2, "rho": 2400.0}],
-        "boundary": [{"group": "b:z0"}],
-        "loads": {"base": [{"record": rec, "direction": [1.0, 0.0, 0.0]}]},
-        "damping": {"alpha": 20.0},
-        "reservoir": {"faces": ["b:x0"], "level": 10.0, "hydrostatic": false, "model": "fe_incompressible",
-            "fluid": {"volume": "block:water", "wet": ["water:x1"], "free_surface": ["water:z1"], "far_end": ["water:x0"]}},
-        "time": {"duration": 0.3}
-    }));
-    let pb = problem(mesh, &sc, 0.9);
-    let model = &pb.model;
-    let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
-    for _ in 0..sim.n_steps() {
-        sim.step().unwrap();
-    }
-    let mut ku = vec![0.0; 3 * model.n_nodes()];
-    model.internal_forces_into(&sim.state.u, &mut ku);
-    let a = 0.2 * 9.81;
-    let mut v = 0.0;
-    for &nd in &model.mesh.group_nodes("b:z0").unwrap() {
-        v += ku[3 * nd] + model.mass.apply(nd, &nalgebra::Vector3::new(a, 0.0, 0.0))[0];
-    }
-    let m_total: f64 = model.mass.inertial.iter().sum();
+    let reservoir = serde_json::json!({"faces": ["b:x0"], "level": 10.0, "hydrostatic": false, "model": "fe_incompressible",
+        "fluid": {"volume": "block:water", "wet": ["water:x1"], "free_surface": ["water:z1"], "far_end": ["water:x0"]}});
+    let (v, m_total, a, pb) = stiff_block_base_shear("reservoir_fe_base_shear", mesh, reservoir);
     let expect = (m_total + westergaard_series_resultant(1000.0, 10.0) * 3.0) * a;
     println!("fe water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {:?}", 100.0 * (v / expect - 1.0), pb.notes);
     assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs {expect}");
