@@ -231,12 +231,24 @@ fn base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass() {
     // (block 2 × 3 × 10 m, E = 10⁵ GPa, ramp to 0.2 g over 0.2 s, V at 0.3 s) with the water
     // meshed (3H long, hex8 36 × 2 × 18, non-conforming with the block's 3 × 20 face).
     // Tolerance 1 % (the FE resultant is −0.2 % at this water mesh, the rigid-wall test).
-    let dir = crate::common::scratch("reservoir_fe_base_shear");
+    let (v, expect, notes) = stiff_block_base_shear("reservoir_fe_base_shear", "fe_incompressible", false);
+    println!("fe water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {notes:?}", 100.0 * (v / expect - 1.0));
+    assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs {expect}");
+}
+
+/// The base shear V [N] at 0.3 s of a stiff block 2 × 3 × 10 m (E = 10⁵ GPa, ρ = 2400, hex8
+/// 2 × 3 × 20, fixed at z = 0, α = 20 1/s) wet on x = 0 to its crest, with the water meshed 3H
+/// upstream (hex8 36 × 2 × 18, non-conforming with the block's 3 × 20 face) under `model`,
+/// its base ramped to 0.2 g along x over 0.2 s (linearly, or by a half cosine when `smooth`)
+/// and held; the quasi-static expectation (M + 0.542754 ρw H² b) a; the run's notes.
+fn stiff_block_base_shear(scratch: &str, model: &str, smooth: bool) -> (f64, f64, Vec<String>) {
+    let dir = crate::common::scratch(scratch);
     let rec = dir.join("ramp.txt");
     let mut txt = String::from("# t [s], a [g]\n");
     for i in 0..=400 {
         let t = 0.5 * i as f64 / 400.0;
-        txt.push_str(&format!("{t} {}\n", 0.2 * (t / 0.2f64).min(1.0)));
+        let r = if smooth { if t < 0.2 { 0.5 * (1.0 - (PI * t / 0.2).cos()) } else { 1.0 } } else { (t / 0.2f64).min(1.0) };
+        txt.push_str(&format!("{t} {}\n", 0.2 * r));
     }
     std::fs::write(&rec, txt).unwrap();
     let mut mesh = box_mesh(&BoxSpec::new("b", [2.0, 3.0, 10.0], [2, 3, 20]));
@@ -247,7 +259,7 @@ fn base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass() {
         "boundary": [{"group": "b:z0"}],
         "loads": {"base": [{"record": rec, "direction": [1.0, 0.0, 0.0]}]},
         "damping": {"alpha": 20.0},
-        "reservoir": {"faces": ["b:x0"], "level": 10.0, "hydrostatic": false, "model": "fe_incompressible",
+        "reservoir": {"faces": ["b:x0"], "level": 10.0, "hydrostatic": false, "model": model,
             "fluid": {"volume": "block:water", "wet": ["water:x1"], "free_surface": ["water:z1"], "far_end": ["water:x0"]}},
         "time": {"duration": 0.3}
     }));
@@ -266,8 +278,7 @@ fn base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass() {
     }
     let m_total: f64 = model.mass.inertial.iter().sum();
     let expect = (m_total + westergaard_series_resultant(1000.0, 10.0) * 3.0) * a;
-    println!("fe water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {:?}", 100.0 * (v / expect - 1.0), pb.notes);
-    assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs {expect}");
+    (v, expect, sim.notes.clone())
 }
 
 #[test]
@@ -533,4 +544,20 @@ fn acoustic_water_at_rest_under_gravity_holds_the_hydrostatic_state_for_10_s() {
     println!("acoustic water at rest, {steps} steps of {:.3e} s: drift {:.3e} of the static {umax:.3e} m, largest |p| {pmax:.3e} Pa; notes {:?}", sim.dt(), drift / umax, sim.notes);
     assert!(drift <= 1e-6 * umax, "drift {drift} of {umax}");
     assert!(pmax <= 1e-6 * 1000.0 * 9.81 * 10.0, "p {pmax}");
+}
+
+#[test]
+fn base_shear_of_a_stiff_block_with_acoustic_water_tends_to_the_incompressible_added_mass() {
+    // Reference: under a base acceleration that rises slowly against the water's first
+    // resonance (c/4H = 36 Hz for H = 10 m) and then holds, compressible water carries the
+    // incompressible pressure (p̈ → 0: H p = ρw G a), so the base shear of a stiff block tends to
+    // (M + 0.542754 ρw H² b) a (Westergaard's exact series, rigid wall, semi-infinite
+    // reservoir). The setup of base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass
+    // with "acoustic" (the water driven through the step's hook, both ways) and a half-cosine
+    // ramp to 0.2 g over 0.2 s (7 periods of the resonance: little ringing), V at 0.3 s.
+    // Tolerance 2 % (FE resultant −0.26 % at this water mesh; what rings on after the ramp).
+    // Measured −1.94 % (fe_incompressible on the same block: −0.11 %).
+    let (v, expect, notes) = stiff_block_base_shear("reservoir_acoustic_base_shear", "acoustic", true);
+    println!("acoustic water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {notes:?}", 100.0 * (v / expect - 1.0));
+    assert!((v / expect - 1.0).abs() < 0.02, "base shear {v} vs {expect}");
 }
