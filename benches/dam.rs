@@ -24,6 +24,8 @@
 //! `JQ_BENCH_REPEATS` (default 3), `JQ_BENCH_STEPS` (default 100), `JQ_BENCH_GS_TOL` (Gauss–Seidel
 //! tolerance as a fraction of joint J01's size; default the solver's, 1e-12 of the model size),
 //! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint).
+//! Then the step with each reservoir model against Westergaard's (`reservoir_models`, knob
+//! `JQ_DAM_RESERVOIR`, default "coarse").
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
 
 use jointquake::problem::foundation::CondensationMethod;
@@ -202,6 +204,111 @@ fn main() {
             }
         }
     });
+    let reservoir = pool.install(|| reservoir_models(repeats, steps));
     let _ = std::fs::create_dir_all(root().join("target/bench"));
-    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows})).unwrap());
+    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir})).unwrap());
+}
+
+/// The step with each reservoir model against the Westergaard step (issue 28; goals:
+/// `fe_incompressible` ≤ 1.5×, `acoustic` ≤ 2×). The dam with its meshed water: coarse (the
+/// committed tests/fixtures/arch_dam_coarse_water.msh) and/or default (`arch_dam.geo -setnumber
+/// water 1`, meshed into target/bench-mesh), `JQ_DAM_RESERVOIR` (comma list, default "coarse";
+/// "none" skips). The bench scene with the massless rock, and instead of the traction the
+/// reservoir at 205 m (hydrostatic on) with `westergaard`, `fe_incompressible` (its lumping in
+/// the step) and `acoustic` (c = 1440 m/s, Sommerfeld far end, rigid bed). Per model: the
+/// build (the condensation of `fe_incompressible` is paid there), the step (best / median of
+/// `repeats` × `steps` after 20 warm-up steps), and for `acoustic` the water's own share (its
+/// hook alone, best of 20 calls) and its stable step beside the solid's, and what a dense solve
+/// on the wet dofs would cost per step (the full incompressible operator in the explicit step;
+/// `JQ_DAM_DENSE=0` skips it: its factor takes minutes on the default mesh).
+fn reservoir_models(repeats: usize, steps: usize) -> Vec<serde_json::Value> {
+    let sizes = std::env::var("JQ_DAM_RESERVOIR").unwrap_or_else(|_| "coarse".into());
+    let mut rows = Vec::new();
+    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty() && *s != "none") {
+        let mesh = match size {
+            "coarse" => Mesh::from_msh(root().join("tests/fixtures/arch_dam_coarse_water.msh")).map_err(|e| e.to_string()),
+            "default" => {
+                let set: BTreeMap<String, f64> = [("water".to_string(), 1.0)].into_iter().collect();
+                jointquake::gmsh::mesh_geo(&root().join("geo/arch_dam.geo"), &set, &root().join("target/bench-mesh")).map_err(|e| e.to_string()).and_then(|m| Mesh::from_msh(m).map_err(|e| e.to_string()))
+            }
+            other => Err(format!("unknown size \"{other}\" in JQ_DAM_RESERVOIR (coarse, default, none)")),
+        };
+        let mesh = match mesh {
+            Ok(m) => m,
+            Err(e) => {
+                println!("  reservoir models, {size}: skipped ({e})");
+                continue;
+            }
+        };
+        let mut base_step = f64::NAN;
+        for model in ["westergaard", "fe_incompressible", "acoustic"] {
+            let mut v = serde_json::to_value(scene(true)).expect("bench scene");
+            v["loads"] = serde_json::json!({"gravity": {}});
+            v["reservoir"] = serde_json::json!({"faces": ["face:upstream"], "level": 205.0, "model": model});
+            if model != "westergaard" {
+                v["reservoir"]["fluid"] = serde_json::json!({"volume": "block:water", "wet": ["water:dam"], "free_surface": ["water:surface"], "far_end": ["water:far"]});
+            }
+            let mut sc: Scene = serde_json::from_value(v).expect("reservoir bench scene");
+            jointquake::pipeline::expand_patterns(&mut sc, &mesh, std::path::Path::new("benches/dam.rs")).expect("patterns expand on the dam mesh");
+            let t1 = Instant::now();
+            let problem = Problem::build(sc, mesh.clone()).expect("dam model with its reservoir");
+            let mut sim = Simulation::new(&problem).expect("dam simulation");
+            let t_build = t1.elapsed().as_secs_f64();
+            for _ in 0..20 {
+                sim.step().expect("step");
+            }
+            let mut per_step = Vec::new();
+            let mut sweeps = 0usize;
+            for _ in 0..repeats {
+                let t = Instant::now();
+                for _ in 0..steps {
+                    sweeps += sim.step().expect("step").correction.iterations;
+                }
+                per_step.push(t.elapsed().as_secs_f64() / steps as f64);
+            }
+            let sweeps = sweeps as f64 / (repeats * steps) as f64;
+            let (b, m) = (best(&per_step), median(&per_step));
+            if model == "westergaard" {
+                base_step = m;
+            }
+            let dt = sim.dt();
+            let mut water_ms = f64::NAN;
+            let mut water_note = String::new();
+            let mut dense_ms = (0usize, f64::NAN, f64::NAN);
+            if let Some(w) = sim.water.as_mut() {
+                let a = vec![[0.1, 0.2, 0.0]; w.water.coupling.dam_nodes.len()];
+                water_ms = 1e3 * (0..20).map(|_| { let t = Instant::now(); w.advance_with_acceleration(&a, dt); t.elapsed().as_secs_f64() }).fold(f64::INFINITY, f64::min);
+                water_note = w.water.note(dt);
+                if std::env::var("JQ_DAM_DENSE").map_or(true, |v| v != "0") {
+                    dense_ms = dense_wet_solve_ms(3 * w.water.coupling.dam_nodes.len());
+                }
+            }
+            println!(
+                "  reservoir {model} ({size} mesh with water): build {t_build:.2} s; step {:.3} / {:.3} ms (best / median), {:.2}× the westergaard step, {sweeps:.1} Gauss–Seidel sweeps per step{}",
+                1e3 * b,
+                1e3 * m,
+                m / base_step,
+                if water_ms.is_nan() { String::new() } else { format!("; the water's hook alone {water_ms:.3} ms per step ({water_note})") }
+            );
+            if dense_ms.0 > 0 {
+                println!("    the full incompressible operator in the step would need a dense solve on the {} wet dofs: factor {:.2} s once, {:.3} ms per step (two triangular solves, best of 5)", dense_ms.0, dense_ms.1, dense_ms.2);
+            }
+            rows.push(serde_json::json!({"size": size, "model": model, "build_s": t_build, "best_step_s": b, "median_step_s": m, "ratio_to_westergaard": m / base_step, "gs_sweeps_per_step": sweeps, "dt": dt, "water_hook_ms": water_ms, "water": water_note, "dense_wet_dofs": dense_ms.0, "dense_factor_s": dense_ms.1, "dense_solve_ms": dense_ms.2}));
+        }
+    }
+    rows
+}
+
+/// The cost of the full incompressible operator in the explicit step (docs/dam_physics.md, "What
+/// is left"): a dense SPD matrix of the wet dofs' size n (diagonal 2, off-diagonal 1/n: the
+/// structure of M + M_a, whose values do not change the cost), its Cholesky factor (s) and one
+/// solve with it (ms, best of 5).
+fn dense_wet_solve_ms(n: usize) -> (usize, f64, f64) {
+    let a = nalgebra::DMatrix::<f64>::from_fn(n, n, |i, j| if i == j { 2.0 } else { 1.0 / n as f64 });
+    let t = Instant::now();
+    let Some(ch) = a.cholesky() else { return (n, f64::NAN, f64::NAN) };
+    let factor = t.elapsed().as_secs_f64();
+    let b = nalgebra::DVector::<f64>::from_element(n, 1.0);
+    let solve = (0..5).map(|_| { let t = Instant::now(); let x = ch.solve(&b); std::hint::black_box(x); t.elapsed().as_secs_f64() }).fold(f64::INFINITY, f64::min);
+    (n, factor, 1e3 * solve)
 }

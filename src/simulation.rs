@@ -90,6 +90,8 @@ pub struct Simulation<'p> {
     pub foundation: Option<crate::problem::foundation::Condensation>,
     /// The radiating foundation's far boundary (`None` for the other foundation models).
     pub radiating: Option<crate::problem::foundation::radiating::Radiating<'p>>,
+    /// The acoustic reservoir's water (`None` for the other reservoir models).
+    pub water: Option<crate::problem::reservoir::acoustic::AcousticRun<'p>>,
     pub state: State,
     /// The outcome of [`Self::equilibrate`] (`None` before it, or without a static state).
     pub equilibrium: Option<EquilibriumInfo>,
@@ -130,6 +132,9 @@ impl<'p> Simulation<'p> {
         let far_w2 = problem.far_boundary.as_ref().map(|f| f.omega2_bound(model)).unwrap_or(0.0);
         let time = TimeStep::resolve(model, &problem.scene.time, penalty + found_w2 + far_w2)?;
         notes.extend(time.note());
+        // the acoustic water: relative to the moving base unless the foundation radiates
+        let water = problem.water.as_ref().map(|w| crate::problem::reservoir::acoustic::AcousticRun::new(w, &problem.loads, problem.far_boundary.is_none(), time.dt));
+        notes.extend(problem.water.as_ref().map(|w| w.note(time.dt)));
         let mut solver = ExplicitSolver::new(model, time.dt, problem.scene.time.energy_tolerance);
         solver.dynamic_held = problem.far_boundary.as_ref().map(|f| f.dynamic_held.clone());
         let mut state = State::at_rest(model, ContactState::new(&problem.joints));
@@ -137,7 +142,7 @@ impl<'p> Simulation<'p> {
         if let Some(r) = radiating.as_mut() {
             r.start(model, &problem.loads, &state.u);
         }
-        Ok(Simulation { problem, time, solver, contact, foundation, radiating, state, equilibrium: None, notes })
+        Ok(Simulation { problem, time, solver, contact, foundation, radiating, water, state, equilibrium: None, notes })
     }
 
     /// The step [s].
@@ -273,20 +278,29 @@ impl<'p> Simulation<'p> {
         if let Some(r) = self.radiating.as_mut() {
             r.start(&self.problem.model, &self.problem.loads, &self.state.u);
         }
+        if let Some(w) = self.water.as_mut() {
+            w.restart();
+        }
     }
 
     /// One dynamic step (gravity, base motion, loads, Rayleigh damping, contact).
     pub fn step(&mut self) -> Result<StepInfo, StepError> {
         let p = self.problem;
-        if let Some(r) = self.radiating.as_mut() {
-            let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(3);
+        if self.radiating.is_some() || self.water.is_some() {
+            let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(4);
             if let Some(c) = self.contact.as_mut() {
                 cs.push(c);
             }
             if let Some(f) = self.foundation.as_mut() {
                 cs.push(f);
             }
-            cs.push(r);
+            if let Some(r) = self.radiating.as_mut() {
+                cs.push(r);
+            }
+            // last: the water reads the dam's final u[n+1]
+            if let Some(w) = self.water.as_mut() {
+                cs.push(w);
+            }
             return self.solver.step(&p.model, &p.loads, &mut self.state, Stage::Dynamic, &mut cs);
         }
         match (self.contact.as_mut(), self.foundation.as_mut()) {

@@ -30,6 +30,8 @@ pub struct Problem {
     pub notes: Vec<String>,
     /// The radiating foundation's far boundary (`None` for the other foundation models).
     pub far_boundary: Option<foundation::radiating::FarBoundary>,
+    /// The acoustic water of `reservoir.model: "acoustic"` (`None` for the other models).
+    pub water: Option<reservoir::acoustic::AcousticWater>,
 }
 
 impl Problem {
@@ -57,7 +59,8 @@ impl Problem {
             notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), loads.static_forces.len(), total));
         }
         let far_boundary = foundation::massed::prepare_loads(&scene, &model, &mut loads, &mut notes)?;
-        Ok(Problem { scene, model, joints, loads, notes, far_boundary })
+        let water = reservoir::acoustic_water_of_scene(&model.mesh, &scene)?;
+        Ok(Problem { scene, model, joints, loads, notes, far_boundary, water })
     }
 }
 

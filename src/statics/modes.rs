@@ -73,6 +73,9 @@ pub fn modes_with(problem: &Problem, count: usize, out_dir: &Path, full_fluid_ma
     if count == 0 {
         return Err(ModelError::Invalid("modes: -n must be at least 1".into()).into());
     }
+    if problem.scene.reservoir.as_ref().is_some_and(|r| r.added_mass && r.model == crate::scene::reservoir::ReservoirModel::Acoustic) {
+        return Err(ModelError::Invalid("modes: reservoir.model \"acoustic\" (compressible water) has no frequency-independent added mass, so the dam's modes with it are not an eigenproblem of K and M: run `modes` with \"fe_incompressible\" (its limit c → ∞) on the same water mesh, or \"westergaard\"".into()).into());
+    }
     let model = &problem.model;
     let n = 3 * model.n_nodes();
     let k = stiffness(model, &vec![true; model.materials.len()]);

@@ -115,12 +115,19 @@ pub fn patch_errors(r: &jointquake::testcase::run::CaseResult) -> (f64, f64, f64
 /// A record file `ramp.txt` in `dir`: the acceleration ramps linearly from 0 to `a_g` [g]
 /// over `ramp` s, then holds, to `end` s (401 samples).
 pub fn ramp_record(dir: &std::path::Path, a_g: f64, ramp: f64, end: f64) -> PathBuf {
+    ramp_record_shaped(dir, a_g, ramp, end, false)
+}
+
+/// As [`ramp_record`], the rise a half cosine 0.5 (1 − cos(π t / `ramp`)) when `smooth`
+/// (no kink at either end: little ringing of a stiff or acoustic system).
+pub fn ramp_record_shaped(dir: &std::path::Path, a_g: f64, ramp: f64, end: f64, smooth: bool) -> PathBuf {
     let p = dir.join("ramp.txt");
     let mut s = String::from("# t [s], a [g]\n");
     let n = 400;
     for i in 0..=n {
         let t = end * i as f64 / n as f64;
-        s.push_str(&format!("{t} {}\n", a_g * (t / ramp).min(1.0)));
+        let r = if smooth && t < ramp { 0.5 * (1.0 - (std::f64::consts::PI * t / ramp).cos()) } else { (t / ramp).min(1.0) };
+        s.push_str(&format!("{t} {}\n", a_g * r));
     }
     std::fs::write(&p, s).unwrap();
     p
@@ -133,9 +140,9 @@ pub fn ramp_record(dir: &std::path::Path, a_g: f64, ramp: f64, end: f64) -> Path
 /// reaction Σ (K u)_x over the fixed base nodes plus their inertia, which moves with the
 /// ground), the model's total inertial mass [kg], the ground acceleration a [m/s²] and the
 /// problem.
-pub fn stiff_block_base_shear(test: &str, mesh: Mesh, reservoir: serde_json::Value) -> (f64, f64, f64, Problem) {
+pub fn stiff_block_base_shear(test: &str, mesh: Mesh, reservoir: serde_json::Value, smooth: bool) -> (f64, f64, f64, Problem) {
     let dir = scratch(test);
-    let rec = ramp_record(&dir, 0.2, 0.2, 0.5);
+    let rec = ramp_record_shaped(&dir, 0.2, 0.2, 0.5, smooth);
     let sc = scene(serde_json::json!({
         "geometry": {"msh": "none.msh"},
         "materials": [{"group": "block:b", "E": 1e14, "nu": 0.2, "rho": 2400.0}],

@@ -1,6 +1,7 @@
 //! The reservoir as a fluid (issue 28): the incompressible FE added mass on a meshed water
-//! volume against Westergaard's exact series, the non-conforming wet-face transfer, and the
-//! model's use in `modes`. Structured box meshes (no gmsh).
+//! volume against Westergaard's exact series, the non-conforming wet-face transfer, the
+//! model's use in `modes`, and the compressible acoustic water against the closed forms of a
+//! rigid dam on a compressible reservoir. Structured box meshes (no gmsh).
 
 use crate::common::{problem, scene, stiff_block_base_shear};
 use jointquake::mesh::structured::{add_box, box_mesh, BoxSpec};
@@ -46,7 +47,16 @@ fn wall_and_water(h: f64, b: f64, lw: f64, water_div: [usize; 3], tets: bool) ->
 }
 
 fn water_groups() -> FluidScene {
-    FluidScene { volume: "block:water".into(), wet: vec!["water:x0".into()], free_surface: vec!["water:z1".into()], far_end: vec!["water:x1".into()] }
+    FluidScene {
+        volume: "block:water".into(),
+        wet: vec!["water:x0".into()],
+        free_surface: vec!["water:z1".into()],
+        far_end: vec!["water:x1".into()],
+        bottom: vec![],
+        reflection: None,
+        sound_speed: None,
+        vapour_pressure: None,
+    }
 }
 
 fn rigid_wall_reservoir(h: f64, b: f64, water_div: [usize; 3], tets: bool) -> (Mesh, IncompressibleReservoir) {
@@ -221,14 +231,23 @@ fn base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass() {
     // (block 2 × 3 × 10 m, E = 10⁵ GPa, ramp to 0.2 g over 0.2 s, V at 0.3 s) with the water
     // meshed (3H long, hex8 36 × 2 × 18, non-conforming with the block's 3 × 20 face).
     // Tolerance 1 % (the FE resultant is −0.2 % at this water mesh, the rigid-wall test).
+    let (v, expect, notes) = water_block_base_shear("reservoir_fe_base_shear", "fe_incompressible", false);
+    println!("fe water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {notes:?}", 100.0 * (v / expect - 1.0));
+    assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs {expect}");
+}
+
+/// The base shear V [N] at 0.3 s of the stiff block of `common::stiff_block_base_shear` wet on
+/// x = 0 to its crest, with the water meshed 3H upstream (hex8 36 × 2 × 18, non-conforming with
+/// the block's 3 × 20 face) under `model`, its base ramped to 0.2 g (linearly, or by a half
+/// cosine when `smooth`); the quasi-static expectation (M + 0.542754 ρw H² b) a; the notes.
+fn water_block_base_shear(scratch: &str, model: &str, smooth: bool) -> (f64, f64, Vec<String>) {
     let mut mesh = box_mesh(&BoxSpec::new("b", [2.0, 3.0, 10.0], [2, 3, 20]));
     add_box(&mut mesh, &BoxSpec::new("water", [30.0, 3.0, 10.0], [36, 2, 18]).at([-30.0, 0.0, 0.0]));
-    let reservoir = serde_json::json!({"faces": ["b:x0"], "level": 10.0, "hydrostatic": false, "model": "fe_incompressible",
+    let reservoir = serde_json::json!({"faces": ["b:x0"], "level": 10.0, "hydrostatic": false, "model": model,
         "fluid": {"volume": "block:water", "wet": ["water:x1"], "free_surface": ["water:z1"], "far_end": ["water:x0"]}});
-    let (v, m_total, a, pb) = stiff_block_base_shear("reservoir_fe_base_shear", mesh, reservoir);
+    let (v, m_total, a, pb) = stiff_block_base_shear(scratch, mesh, reservoir, smooth);
     let expect = (m_total + westergaard_series_resultant(1000.0, 10.0) * 3.0) * a;
-    println!("fe water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {:?}", 100.0 * (v / expect - 1.0), pb.notes);
-    assert!((v / expect - 1.0).abs() < 0.01, "base shear {v} vs {expect}");
+    (v, expect, pb.notes.clone())
 }
 
 #[test]
@@ -267,4 +286,247 @@ fn coarse_dam_first_frequencies_with_each_reservoir_model() {
         drop(fe_lumped)
     );
     assert!(fe_lumped <= fe * (1.0 + 1e-9) && fe < f_empty && f_wg < f_empty, "{fe_lumped} {fe} {f_wg} {f_empty}");
+}
+
+// ---------------------------------------------------------------- acoustic water (compressible)
+
+use jointquake::problem::reservoir::acoustic::{AcousticRun, AcousticWater};
+use rustfft::num_complex::Complex;
+
+/// A rigid dam face at x = 0 (block [−2, 0] × [0, b] × [0, 1.2 h], wet face `dam:x1`) and the
+/// acoustic water [0, lw] × [0, b] × [0, h] (hex8 `div`) with `fluid`'s groups, pool at h.
+fn acoustic_channel(h: f64, b: f64, lw: f64, div: [usize; 3], fluid: &FluidScene) -> (Mesh, AcousticWater) {
+    let mesh = wall_and_water(h, b, lw, div, false);
+    let dam_cells = mesh.group("block:dam").unwrap().cells.clone();
+    let faces = wet_faces(&mesh, "dam:x1", &dam_cells).unwrap();
+    let spec = ReservoirSpec { rho_w: 1000.0, level: h, bottom: 0.0, g: 9.81, local_depth: false };
+    let water = AcousticWater::build(&mesh, &faces, &spec, fluid).unwrap();
+    (mesh, water)
+}
+
+/// The water's unknown at the wall's foot (x = 0, z = 0, the y = 0 corner).
+fn wall_foot_unknown(mesh: &Mesh, water: &AcousticWater) -> usize {
+    water.fluid.nodes.iter().position(|&v| mesh.nodes[v][0].abs() < 1e-9 && mesh.nodes[v][2].abs() < 1e-9 && mesh.nodes[v][1].abs() < 1e-9).unwrap()
+}
+
+/// Chopra (1967) and Fenves & Chopra (1984): the harmonic pressure at the foot (x = 0, y = 0)
+/// of a rigid vertical dam accelerating at a e^{iωt} (a = 1 m/s²) into a compressible reservoir of
+/// depth h, infinite upstream, bottom reflection coefficient α (y up from the bottom):
+/// p = Σ_n A_n Y_n(y) e^{−κ_n x}, Y_n = sin(λ_n (h − y)) (p = 0 at the surface), the bottom
+/// condition ∂p/∂y = iωq p with q = (1 − α)/((1 + α) c) gives λ cos λh + iωq sin λh = 0 (λ_n real,
+/// (2n−1)π/2h, when α = 1; complex otherwise, found by Newton from those), κ_n = √(λ_n² − ω²/c²)
+/// (Re ≥ 0: decaying or outgoing), and ∂p/∂x = −ρ a at the wall A_n = ρ a ∫Y_n / (κ_n ∫Y_n²)
+/// (the Y_n are orthogonal without conjugation). |p(0, 0)| [Pa], 2000 terms.
+fn chopra_foot_pressure(rho: f64, c: f64, h: f64, omega: f64, alpha: f64) -> f64 {
+    let q = (1.0 - alpha) / ((1.0 + alpha) * c);
+    let iwq = Complex::new(0.0, omega * q);
+    let mut p = Complex::new(0.0, 0.0);
+    for n in 1..=2000 {
+        let mut l = Complex::new((2 * n - 1) as f64 * PI / (2.0 * h), 0.0);
+        for _ in 0..50 {
+            let (s, co) = ((l * h).sin(), (l * h).cos());
+            let f = l * co + iwq * s;
+            let df = co - l * h * s + iwq * h * co;
+            let step = f / df;
+            l -= step;
+            if step.norm() < 1e-14 * l.norm() {
+                break;
+            }
+        }
+        let kappa = (l * l - Complex::new(omega * omega / (c * c), 0.0)).sqrt();
+        let int_y = (Complex::new(1.0, 0.0) - (l * h).cos()) / l;
+        let int_y2 = Complex::new(h / 2.0, 0.0) - (l * 2.0 * h).sin() / (l * 4.0);
+        p += rho * int_y / (kappa * int_y2) * (l * h).sin();
+    }
+    p.norm()
+}
+
+/// The steady harmonic amplitude of the pressure at the wall's foot: the rigid wall accelerates
+/// at sin(ωt) along +x (into the water), ramped in by a half cosine over `ramp` periods, for
+/// `periods` periods; the amplitude is fitted (sin and cos) over the last 4 periods.
+fn harmonic_foot_amplitude(mesh: &Mesh, water: &AcousticWater, f: f64, ramp: f64, periods: usize) -> f64 {
+    let loads = jointquake::dynamics::loads::Loads::default();
+    let per = 1.0 / f;
+    // a whole number of steps per period, within the water's stable step
+    let steps_per = (per / (0.9 * water.stable_step())).ceil() as usize;
+    let dt = per / steps_per as f64;
+    let mut run = AcousticRun::new(water, &loads, false, dt);
+    assert_eq!(run.substeps, 1);
+    let foot = wall_foot_unknown(mesh, water);
+    let nd = water.coupling.dam_nodes.len();
+    let w = 2.0 * PI * f;
+    let (mut s, mut c, mut n) = (0.0, 0.0, 0usize);
+    for k in 0..periods * steps_per {
+        let t = k as f64 * dt;
+        let env = if t < ramp * per { 0.5 * (1.0 - (PI * t / (ramp * per)).cos()) } else { 1.0 };
+        run.advance_with_acceleration(&vec![[env * (w * t).sin(), 0.0, 0.0]; nd], dt);
+        // p now at t + dt
+        if k >= (periods - 4) * steps_per {
+            let tp = t + dt;
+            s += run.p[foot] * (w * tp).sin();
+            c += run.p[foot] * (w * tp).cos();
+            n += 1;
+        }
+    }
+    let (s, c) = (2.0 * s / n as f64, 2.0 * c / n as f64);
+    (s * s + c * c).sqrt()
+}
+
+#[test]
+fn acoustic_water_resonances_of_a_rigid_wall_are_the_quarter_wave_frequencies() {
+    // Reference: a rigid dam on a compressible reservoir of depth h resonates at the cut-off
+    // frequencies of the channel's modes, f_n = (2n − 1) c / 4h (Chopra 1967): there the mode's
+    // pressure is uniform upstream and the wall's response unbounded. Those are the frequencies
+    // of the x-uniform fields of the FE water; measured here by an impulse of the wall on a short
+    // closed basin (lw = h/4, rigid far end: its other modes, √((2n−1)² + (8m)²) c/4h, lie far
+    // from f1..f3), the pressure at the wall's foot over 10 s (Hann window, zero-padded ×16
+    // FFT, parabolic peak), n = 1, 2, 3. Tolerance 1 % (issue 28). h = 36 m, c = 1440 m/s:
+    // f1 = 10 Hz; hex8 of 1.5 m (24 over h).
+    let (h, c) = (36.0, 1440.0);
+    let mut fluid = water_groups();
+    fluid.far_end = vec![];
+    let (mesh, water) = acoustic_channel(h, 1.5, h / 4.0, [6, 1, 24], &fluid);
+    let loads = jointquake::dynamics::loads::Loads::default();
+    let dt = 0.5 * water.stable_step();
+    let mut run = AcousticRun::new(&water, &loads, false, dt);
+    let foot = wall_foot_unknown(&mesh, &water);
+    let nd = water.coupling.dam_nodes.len();
+    let n = (10.0 / dt) as usize;
+    let (t0, sigma) = (0.005, 0.001);
+    let mut rec = Vec::with_capacity(n);
+    for k in 0..n {
+        let t = k as f64 * dt;
+        let a = (-((t - t0) / sigma).powi(2)).exp();
+        run.advance_with_acceleration(&vec![[a, 0.0, 0.0]; nd], dt);
+        rec.push(run.p[foot]);
+    }
+    let m = 16 * n.next_power_of_two();
+    let mut buf: Vec<Complex<f64>> = (0..m).map(|k| if k < n { Complex::new(rec[k] * (0.5 - 0.5 * (2.0 * PI * k as f64 / n as f64).cos()), 0.0) } else { Complex::new(0.0, 0.0) }).collect();
+    rustfft::FftPlanner::new().plan_fft_forward(m).process(&mut buf);
+    let df = 1.0 / (m as f64 * dt);
+    for k in 1..=3 {
+        let exact = (2 * k - 1) as f64 * c / (4.0 * h);
+        let (lo, hi) = ((0.8 * exact / df) as usize, (1.2 * exact / df) as usize);
+        let i = (lo..hi).max_by(|&a, &b| buf[a].norm().total_cmp(&buf[b].norm())).unwrap();
+        let (ym, y0, yp) = (buf[i - 1].norm(), buf[i].norm(), buf[i + 1].norm());
+        let peak = (i as f64 + 0.5 * (ym - yp) / (ym - 2.0 * y0 + yp)) * df;
+        println!("acoustic resonance n = {k}: FE {peak:.4} Hz, exact {exact:.4} Hz ({:+.3} %)", 100.0 * (peak / exact - 1.0));
+        assert!((peak / exact - 1.0).abs() < 0.01, "n {k}: {peak} vs {exact}");
+    }
+}
+
+#[test]
+fn acoustic_harmonic_wall_pressure_matches_chopras_rigid_dam_solution() {
+    // Reference: `chopra_foot_pressure` (Chopra 1967 for α = 1; Fenves & Chopra 1984 with the
+    // bottom's reflection coefficient α < 1), the pressure amplitude at the foot of a rigid
+    // dam on a reservoir infinite upstream. FE: h = 36 m (f1 = c/4h = 10 Hz), water 3h long
+    // with the Sommerfeld far end, hex8 1.5 m, the wall driven harmonically to a steady state.
+    // Tolerances: 3 % away from resonance (issue 28) at 0.5 f1 and 0.8 f1 with a rigid bottom;
+    // at resonance (f1) with α = 0.5 the peak is bounded and within 5 % of the theory's (the
+    // far end's plane-wave condition is not exact for the channel's modes, module doc of
+    // problem::reservoir::acoustic). Measured in the output below and in docs/dam_physics.md.
+    let (h, c, rho) = (36.0, 1440.0, 1000.0);
+    let f1 = c / (4.0 * h);
+    let (mesh, water) = acoustic_channel(h, 1.5, 3.0 * h, [72, 1, 24], &water_groups());
+    for (ratio, tol) in [(0.5, 0.03), (0.8, 0.03)] {
+        let fe = harmonic_foot_amplitude(&mesh, &water, ratio * f1, 4.0, 30);
+        let exact = chopra_foot_pressure(rho, c, h, 2.0 * PI * ratio * f1, 1.0);
+        println!("acoustic harmonic, rigid bottom, f = {ratio} f1: FE {fe:.1} Pa, Chopra {exact:.1} Pa ({:+.3} %), incompressible {:.1} Pa", 100.0 * (fe / exact - 1.0), 0.7425 * rho * h);
+        assert!((fe / exact - 1.0).abs() < tol, "f/f1 {ratio}: {fe} vs {exact}");
+    }
+    let mut fluid = water_groups();
+    fluid.bottom = vec!["water:z0".into()];
+    fluid.reflection = Some(0.5);
+    let (mesh, water) = acoustic_channel(h, 1.5, 3.0 * h, [72, 1, 24], &fluid);
+    let fe = harmonic_foot_amplitude(&mesh, &water, f1, 4.0, 30);
+    let exact = chopra_foot_pressure(rho, c, h, 2.0 * PI * f1, 0.5);
+    println!("acoustic harmonic at resonance, α = 0.5: FE {fe:.1} Pa, Fenves-Chopra {exact:.1} Pa ({:+.3} %)", 100.0 * (fe / exact - 1.0));
+    assert!((fe / exact - 1.0).abs() < 0.05, "resonance α 0.5: {fe} vs {exact}");
+}
+
+#[test]
+fn acoustic_far_end_absorbs_a_plane_pulse() {
+    // Reference: Sommerfeld's condition ∂p/∂t = −c ∂p/∂n is exact for a plane wave at normal
+    // incidence; a pulse leaving the mesh must leave less than 5 % of its energy behind (issue
+    // 28). A rigid duct 2 × 2 m, 240 m long (no free surface, every side rigid), hex8 of 2 m;
+    // the wall at x = 0 pushes a sin² acceleration pulse of 0.05 s (72 m long: 36 elements),
+    // the far end at x = 240 m radiates. The field energy of the water (½ v·Q v + ½ p·H p) once
+    // the pulse is wholly inside, against what is left after its front has had time to leave
+    // and come half-way back.
+    let (len, b, c) = (240.0, 2.0, 1440.0);
+    let mut fluid = water_groups();
+    fluid.free_surface = vec![];
+    let (_, water) = acoustic_channel(b, b, len, [120, 1, 1], &fluid);
+    let loads = jointquake::dynamics::loads::Loads::default();
+    let dt = 0.9 * water.stable_step();
+    let mut run = AcousticRun::new(&water, &loads, false, dt);
+    let nd = water.coupling.dam_nodes.len();
+    let pulse = 0.05;
+    let inside = pulse + 0.25 * len / c;
+    let after = pulse + 1.5 * len / c;
+    let (mut e_in, mut e_after) = (0.0, 0.0);
+    let mut t = 0.0;
+    while t < after {
+        let a = if t < pulse { (PI * t / pulse).sin().powi(2) } else { 0.0 };
+        run.advance_with_acceleration(&vec![[a, 0.0, 0.0]; nd], dt);
+        t += dt;
+        if e_in == 0.0 && t >= inside {
+            e_in = run.field_energy(dt);
+        }
+        e_after = run.field_energy(dt);
+    }
+    println!("acoustic plane pulse: energy inside {e_in:.4e}, left after it reached the far end {e_after:.4e} ({:.3} %)", 100.0 * e_after / e_in);
+    assert!(e_in > 0.0 && e_after / e_in < 0.05, "{e_after} / {e_in}");
+}
+
+#[test]
+fn acoustic_water_at_rest_under_gravity_holds_the_hydrostatic_state_for_10_s() {
+    // Reference: a dam block with its hydrostatic load in static equilibrium (construction
+    // sequence, a direct solve) and the acoustic water at rest: nothing moves; the dynamic
+    // pressure stays 0 and the block at its static displacement over 10 s of explicit steps
+    // (issue 28). Tolerances: |p| below 1e-6 of ρw g H, the block's displacement within 1e-6 of
+    // its static value (relative to that value).
+    let mut mesh = box_mesh(&BoxSpec::new("b", [2.0, 3.0, 10.0], [2, 3, 10]));
+    add_box(&mut mesh, &BoxSpec::new("water", [30.0, 3.0, 10.0], [30, 2, 10]).at([-30.0, 0.0, 0.0]));
+    let sc = scene(serde_json::json!({
+        "geometry": {"msh": "none.msh"},
+        "materials": [{"group": "block:b", "E": 25e9, "nu": 0.2, "rho": 2400.0}],
+        "boundary": [{"group": "b:z0"}],
+        "loads": {"gravity": {"g": 9.81}},
+        "equilibrium": {"sequence": "construction"},
+        "reservoir": {"faces": ["b:x0"], "level": 10.0, "model": "acoustic",
+            "fluid": {"volume": "block:water", "wet": ["water:x1"], "free_surface": ["water:z1"], "far_end": ["water:x0"], "bottom": ["water:z0"], "reflection": 0.8}},
+        "time": {"duration": 10.0}
+    }));
+    let pb = problem(mesh, &sc, 0.9);
+    let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
+    sim.equilibrate().unwrap();
+    let u0 = sim.state.u.clone();
+    let umax = u0.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    assert!(umax > 0.0);
+    let steps = sim.n_steps();
+    for _ in 0..steps {
+        sim.step().unwrap();
+    }
+    let drift = sim.state.u.iter().zip(&u0).fold(0.0f64, |a, (u, v)| a.max((u - v).abs()));
+    let pmax = sim.water.as_ref().unwrap().p.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    println!("acoustic water at rest, {steps} steps of {:.3e} s: drift {:.3e} of the static {umax:.3e} m, largest |p| {pmax:.3e} Pa; notes {:?}", sim.dt(), drift / umax, sim.notes);
+    assert!(drift <= 1e-6 * umax, "drift {drift} of {umax}");
+    assert!(pmax <= 1e-6 * 1000.0 * 9.81 * 10.0, "p {pmax}");
+}
+
+#[test]
+fn base_shear_of_a_stiff_block_with_acoustic_water_tends_to_the_incompressible_added_mass() {
+    // Reference: under a base acceleration that rises slowly against the water's first
+    // resonance (c/4H = 36 Hz for H = 10 m) and then holds, compressible water carries the
+    // incompressible pressure (p̈ → 0: H p = ρw G a), so the base shear of a stiff block tends to
+    // (M + 0.542754 ρw H² b) a (Westergaard's exact series, rigid wall, semi-infinite
+    // reservoir). The setup of base_shear_of_a_stiff_block_with_fe_water_includes_the_exact_added_mass
+    // with "acoustic" (the water driven through the step's hook, both ways) and a half-cosine
+    // ramp to 0.2 g over 0.2 s (7 periods of the resonance: little ringing), V at 0.3 s.
+    // Tolerance 2 % (FE resultant −0.26 % at this water mesh; what rings on after the ramp).
+    // Measured −1.94 % (fe_incompressible on the same block: −0.11 %).
+    let (v, expect, notes) = water_block_base_shear("reservoir_acoustic_base_shear", "acoustic", true);
+    println!("acoustic water base shear {v:.5e} N, expected {expect:.5e} N ({:+.3} %), notes {notes:?}", 100.0 * (v / expect - 1.0));
+    assert!((v / expect - 1.0).abs() < 0.02, "base shear {v} vs {expect}");
 }

@@ -31,8 +31,20 @@ pub struct FluidMesh {
     pub zero_pressure_nodes: usize,
 }
 
-/// The water of `fluid` on `mesh`. Errors name the group and element and say what to fix.
+/// The incompressible water of `fluid` on `mesh`: p = 0 on the free surface and the far end.
+/// Errors name the group and element and say what to fix.
 pub fn fluid_mesh(mesh: &Mesh, fluid: &FluidScene) -> Result<FluidMesh, Error> {
+    let held: Vec<&String> = fluid.free_surface.iter().chain(&fluid.far_end).collect();
+    let water = fluid_mesh_held(mesh, fluid, &held)?;
+    if water.zero_pressure_nodes == 0 {
+        return Err(ModelError::Invalid(format!("reservoir.fluid.free_surface: the groups {:?} have no nodes; the pressure needs p = 0 somewhere", fluid.free_surface)).into());
+    }
+    Ok(water)
+}
+
+/// The water of `fluid` on `mesh` with p = 0 on the face groups `held` only (the acoustic water
+/// holds its free surface and radiates at its far end; it needs no p = 0 face).
+pub fn fluid_mesh_held(mesh: &Mesh, fluid: &FluidScene, held: &[&String]) -> Result<FluidMesh, Error> {
     let g = mesh.group_of_dim(&fluid.volume, 3)?;
     if g.cells.is_empty() {
         return Err(ModelError::Invalid(format!("reservoir.fluid.volume \"{}\" has no elements", fluid.volume)).into());
@@ -46,7 +58,7 @@ pub fn fluid_mesh(mesh: &Mesh, fluid: &FluidScene) -> Result<FluidMesh, Error> {
         }
     }
     let mut zero = vec![false; mesh.nodes.len()];
-    for name in fluid.free_surface.iter().chain(&fluid.far_end) {
+    for &name in held {
         let nodes = mesh.group_nodes(name)?;
         if let Some(&v) = nodes.iter().find(|&&v| !in_water[v]) {
             return Err(ModelError::Invalid(format!(
@@ -70,9 +82,6 @@ pub fn fluid_mesh(mesh: &Mesh, fluid: &FluidScene) -> Result<FluidMesh, Error> {
         }
     }
     let zero_pressure_nodes = zero.iter().filter(|&&z| z).count();
-    if zero_pressure_nodes == 0 {
-        return Err(ModelError::Invalid(format!("reservoir.fluid.free_surface: the groups {:?} have no nodes; the pressure needs p = 0 somewhere", fluid.free_surface)).into());
-    }
     let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); nodes.len()];
     for &c in &cells {
         let cell = &mesh.cells[c];
@@ -96,6 +105,34 @@ pub fn fluid_mesh(mesh: &Mesh, fluid: &FluidScene) -> Result<FluidMesh, Error> {
     }
     let laplacian = from_columns(nodes.len(), cols);
     Ok(FluidMesh { nodes, unknown, wet, laplacian, cells: cells.len(), zero_pressure_nodes })
+}
+
+/// The row-sum lumped volumes ∫ N_a dV [m³] of a tet4 (V/4 each) or hex8 (2×2×2 Gauss);
+/// `None` if degenerate.
+pub fn element_lumped_volumes(kind: CellKind, x: &[Vector3<f64>]) -> Option<Vec<f64>> {
+    match kind {
+        CellKind::Tet4 => {
+            let g = crate::model::tet4::tet_geometry(&[x[0], x[1], x[2], x[3]])?;
+            Some(vec![0.25 * g.vol; 4])
+        }
+        CellKind::Hex8 => {
+            let xs: [Vector3<f64>; 8] = std::array::from_fn(|a| x[a]);
+            let gp = 1.0 / 3f64.sqrt();
+            let r = crate::mesh::cell::HEX8_REF;
+            let mut v = vec![0.0; 8];
+            for s in [[-gp, -gp, -gp], [gp, -gp, -gp], [gp, gp, -gp], [-gp, gp, -gp], [-gp, -gp, gp], [gp, -gp, gp], [gp, gp, gp], [-gp, gp, gp]] {
+                let det = crate::model::hex8::jacobian(&xs, &crate::model::hex8::dshape(s)).determinant();
+                if !(det > 0.0) {
+                    return None;
+                }
+                for a in 0..8 {
+                    v[a] += det * 0.125 * (1.0 + s[0] * r[a][0]) * (1.0 + s[1] * r[a][1]) * (1.0 + s[2] * r[a][2]);
+                }
+            }
+            Some(v)
+        }
+        _ => None,
+    }
 }
 
 /// The element matrix ∫ ∇N_a·∇N_b dV (row-major k×k) of a tet4 or hex8; `None` if degenerate.

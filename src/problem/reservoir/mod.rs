@@ -4,10 +4,13 @@
 //!
 //! Owns: the Westergaard/Kuo added mass and the hydrostatic load (here); the meshed water of
 //! `"fe_incompressible"`: its Laplacian ([`fluid_mesh`]), the non-conforming wet-face coupling
-//! ([`transfer`]) and the condensed added-mass operator with its lumping ([`incompressible`]).
+//! ([`transfer`]) and the condensed added-mass operator with its lumping ([`incompressible`]);
+//! the compressible water of `"acoustic"` on the same mesh and coupling ([`acoustic`]: its
+//! operators, built once, and the run's hook that advances it with the dam).
 //! Inputs: the mesh (the dam's wet face groups; the water's groups), the scene's `reservoir`.
 //! Outputs: nodal forces, nodal 3×3 added-mass blocks ([`added_masses_of_scene`]), and for
-//! `modes` the full FE operator beyond its lumping ([`coupled_added_mass_of_scene`]).
+//! `modes` the full FE operator beyond its lumping ([`coupled_added_mass_of_scene`]), the
+//! acoustic water ([`acoustic_water_of_scene`]).
 //! Invariants: the seed's configuration (`"westergaard"`) is the default and unchanged; every
 //! model's blocks act along the nodal normal only.
 //!
@@ -36,6 +39,7 @@
 //! then misses the resonance peaks (Fenves & Chopra 1984; Chopra's "Earthquake Engineering for
 //! Concrete Dams", 2020). Below f_r the added mass is the standard practice (USACE EM 1110-2-6051).
 
+pub mod acoustic;
 pub mod fluid_mesh;
 pub mod incompressible;
 pub mod transfer;
@@ -294,10 +298,12 @@ pub fn reservoir_spec(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[We
 }
 
 /// The added mass of a scene's reservoir model on its wet faces (the nodal 3×3 blocks the
-/// explicit run uses) and a note: Westergaard/Kuo ([`added_masses`]), or the row-sum lumping of
-/// the incompressible FE operator ([`incompressible`]).
+/// explicit run uses) and a note: Westergaard/Kuo ([`added_masses`]), the row-sum lumping of
+/// the incompressible FE operator ([`incompressible`]), or none for the acoustic water (its
+/// pressure acts through [`acoustic`]).
 pub fn added_masses_of_scene(mesh: &Mesh, r: &crate::scene::ReservoirScene, faces: &[WetFace], spec: &ReservoirSpec) -> Result<(Vec<AddedMass>, String), crate::error::Error> {
     match (r.model, &r.fluid) {
+        (ReservoirModel::Acoustic, _) => Ok((Vec::new(), "acoustic: no added mass, the compressible water is meshed and advanced with the dam".to_string())),
         (ReservoirModel::FeIncompressible, Some(fluid)) => {
             let t0 = std::time::Instant::now();
             let mut water = incompressible::IncompressibleReservoir::build(mesh, faces, spec, fluid)?;
@@ -331,6 +337,17 @@ pub fn coupled_added_mass_of_scene(mesh: &Mesh, scene: &crate::scene::Scene) -> 
     let (faces, spec) = wet_faces_of_scene(mesh, scene, r)?;
     let mut water = incompressible::IncompressibleReservoir::build(mesh, &faces, &spec, fluid)?;
     Ok(Some(water.added_mass()?.coupling_beyond_lumped()))
+}
+
+/// The acoustic water of a scene with `"acoustic"` and its hydrodynamic part on (`added_mass`,
+/// default true); `None` otherwise.
+pub fn acoustic_water_of_scene(mesh: &Mesh, scene: &crate::scene::Scene) -> Result<Option<acoustic::AcousticWater>, crate::error::Error> {
+    let Some(r) = scene.reservoir.as_ref().filter(|r| r.added_mass && r.model == ReservoirModel::Acoustic) else {
+        return Ok(None);
+    };
+    let Some(fluid) = &r.fluid else { return Ok(None) };
+    let (faces, spec) = wet_faces_of_scene(mesh, scene, r)?;
+    Ok(Some(acoustic::AcousticWater::build(mesh, &faces, &spec, fluid)?))
 }
 
 /// The wet faces of a scene's reservoir (`reservoir.faces`, outward from the scene's volumes)
