@@ -2,7 +2,8 @@
 """Load a jointquake ParaView state (the dam study's dam.pvsm) in ParaView itself, render its last
 time step to a PNG and check the picture is not blank.
 
-Usage: xvfb-run -a pvpython render_pvsm.py STATE.pvsm OUT.png [WIDTH HEIGHT]
+Usage: xvfb-run -a pvpython render_pvsm.py STATE.pvsm OUT.png [WIDTH HEIGHT [TIME]]
+(TIME: render the time step nearest to TIME [s] instead of the last one.)
 
 Checks, each failing with a message naming the state file:
 - the state loads, and its pipeline is what `output::pvsm` writes: a PVDReader of the volume,
@@ -21,6 +22,9 @@ import sys
 from paraview.simple import (  # noqa: E402  (pvpython provides paraview.simple)
     GetActiveViewOrCreate,
     GetAnimationScene,
+    GetColorTransferFunction,
+    GetDisplayProperties,
+    GetScalarBar,
     GetSources,
     GetTimeKeeper,
     LoadState,
@@ -40,7 +44,7 @@ def fail(msg):
 
 def main():
     if len(sys.argv) < 3:
-        fail("usage: render_pvsm.py STATE.pvsm OUT.png [WIDTH HEIGHT]")
+        fail("usage: render_pvsm.py STATE.pvsm OUT.png [WIDTH HEIGHT [TIME]]")
     state, png = sys.argv[1], sys.argv[2]
     size = [int(sys.argv[3]), int(sys.argv[4])] if len(sys.argv) >= 5 else [1000, 700]
     LoadState(state)
@@ -71,9 +75,14 @@ def main():
     times = list(GetTimeKeeper().TimestepValues)
     if len(times) < 2:
         fail(f"{state}: {len(times)} time steps")
-    scene.AnimationTime = times[-1]
+    at = times[-1] if len(sys.argv) < 6 else min(times, key=lambda t: abs(t - float(sys.argv[5])))
+    scene.AnimationTime = at
     view = GetActiveViewOrCreate("RenderView")
     view.ViewSize = size
+    # the colour legend of |u| [m] (the state leaves scalar bars to the user)
+    _, warp = by_type["WarpVector"][0]
+    GetDisplayProperties(warp, view).SetScalarBarVisibility(view, True)
+    GetScalarBar(GetColorTransferFunction("displacement"), view).Title = "|displacement| [m]"
     ResetCamera(view)
     Render(view)
     SaveScreenshot(png, view, ImageResolution=size)
@@ -89,7 +98,7 @@ def main():
     fg = px[(abs(px - bg) > 24).any(axis=1)]
     fraction = len(fg) / len(px)
     colours = len({tuple(c) for c in (fg // 8).tolist()})
-    print(f"render_pvsm: {state}: {len(joints)} joints, {len(times)} time steps, threshold keeps {n_out} of {n_in} cells; {png}: {w} x {h} px, {100 * fraction:.1f} % non-background pixels in {colours} colours")
+    print(f"render_pvsm: {state}: {len(joints)} joints, {len(times)} time steps (rendered t = {at:.4g} s), threshold keeps {n_out} of {n_in} cells; {png}: {w} x {h} px, {100 * fraction:.1f} % non-background pixels in {colours} colours")
     if fraction < MIN_FRACTION:
         fail(f"{png}: {100 * fraction:.2f} % of the pixels differ from the background, below {100 * MIN_FRACTION:.0f} %: the picture is blank")
     if colours < MIN_COLOURS:
