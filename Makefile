@@ -75,9 +75,15 @@ test: venv
 	$(PY) scripts/check_vtu.py target/test-demo
 	@echo "== ParaView itself: the demo's volume and joint series together (one time axis, arrays, one PNG)"
 	@if command -v pvpython >/dev/null && command -v xvfb-run >/dev/null; then \
-	  xvfb-run -a pvpython scripts/check_paraview.py target/test-demo target/test-demo/paraview.png; \
+	  scripts/pvrun.sh scripts/check_paraview.py target/test-demo target/test-demo/paraview.png; \
 	else \
 	  echo "make test: ParaView check SKIPPED: pvpython or xvfb-run not installed (Debian: apt-get install paraview python3-paraview xvfb)"; \
+	fi
+	@echo "== ParaView itself: the dam study's state (dam.pvsm of the coarse fixture study run by cargo test, tests/all/dam_study.rs) rendered, not blank"
+	@if command -v pvpython >/dev/null && command -v xvfb-run >/dev/null; then \
+	  scripts/pvrun.sh scripts/render_pvsm.py target/test-scratch/dam_study/small/out/dam.pvsm target/test-scratch/dam_study/small/out/dam.png; \
+	else \
+	  echo "make test: ParaView render of dam.pvsm SKIPPED: pvpython or xvfb-run not installed (Debian: apt-get install paraview python3-paraview xvfb)"; \
 	fi
 	@echo "== meshio cross-check of a scene with a joint (joint series, joint history)"
 	$(BIN) run pipelines/impact.json --out target/test-impact --quiet
@@ -157,9 +163,13 @@ test-slurm: build
 # 3x. Each run prints its start and end; a failed run is named in the report.
 dam:
 	$(MAKE) --no-print-directory study STUDY=pipelines/dam_study.json
+	@echo
+	@echo "ParaView: paraview --state out/dam/dam.pvsm (run nts-default-3x, a frame every 0.05 s: the dam warped and coloured by |u|, the rock hidden, the joints by opening)"
 
 dam-coarse:
 	$(MAKE) --no-print-directory study STUDY=pipelines/dam_coarse_study.json
+	@echo
+	@echo "ParaView: paraview --state out/dam_coarse_study/dam.pvsm (run nts-coarse-3x, a frame every 0.05 s)"
 
 # Mesh convergence of the dam study (docs/dam.md, "Convergence"): NTS and NTN at 1x and 3x on
 # the coarse, default, fine and h 2.5 m meshes (16 runs). Not run whole here: the h 2.5 m runs

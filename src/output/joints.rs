@@ -25,6 +25,7 @@ use crate::contact::law::PairState;
 use crate::error::OutputError;
 use crate::mesh::CellKind;
 use super::history::CsvLines;
+use super::joint_envelope::JointEnvelopeWriter;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -89,6 +90,9 @@ pub struct JointWriter {
     /// equilibrium): a pair's gap is then the tagger's distance to the master surface at rest,
     /// and no node counts as lost.
     pub unsearched: bool,
+    /// Per slave node: the largest opening and net slip over the history rows
+    /// (`joint_envelope.json`, [`super::joint_envelope`]).
+    pub envelope: JointEnvelopeWriter,
 }
 
 /// `r` as the outputs show it: before the first search, the gaps at rest from the tagger.
@@ -172,7 +176,7 @@ impl JointWriter {
             }
         }
         let anchor = joints.iter().map(|j| vec![[f64::NAN; 3]; j.tag.n_slave()]).collect();
-        Ok(JointWriter { dir, series, csv, peaks, frames, forces: fcsv, anchor, unsearched: false })
+        Ok(JointWriter { dir, series, csv, peaks, frames, forces: fcsv, anchor, unsearched: false, envelope: JointEnvelopeWriter::create(joints) })
     }
 
     /// Per slave node of joint `k`: its `lost_travel` [m] (0 when in contact) at displacement
@@ -207,6 +211,7 @@ impl JointWriter {
     pub fn record(&mut self, t: f64, joints: &[ContactJoint], state: &ContactState, u: &[f64]) -> Result<(), OutputError> {
         for (k, (j, r)) in joints.iter().zip(&state.joints).enumerate() {
             let r = &*searched_view(self.unsearched, j, r);
+            self.envelope.sample(k, r, t);
             let travel = self.lost_travel(k, j, r, u);
             let lost = r.pairs.iter().filter(|p| is_lost(p)).count();
             let ml = travel.iter().map(|t| t.0).fold(0.0f64, f64::max);

@@ -1,5 +1,5 @@
 //! Output: VTU frames and `.pvd` series for ParaView (through the `vtk` leaf), joint-surface
-//! files, CSV histories, the run's [`recorder::Recorder`] (schedule, monitors, peaks, progress)
+//! files and their per-node envelopes (`joint_envelope.json`), a ParaView state (`pvsm`), CSV histories, the run's [`recorder::Recorder`] (schedule, monitors, peaks, progress)
 //! and its [`summary::RunSummary`] (written and read back as `summary.json`).
 //!
 //! Owns only writing. Inputs: the immutable model/mesh and read-only views of the state.
@@ -9,6 +9,8 @@
 pub mod envelope;
 pub mod frames;
 pub mod history;
+pub mod joint_envelope;
+pub mod pvsm;
 pub mod joints;
 pub mod recorder;
 pub mod summary;

@@ -17,7 +17,8 @@
 //! - **Monitors**: the scene's points snapped to nodes ([`snap_monitors`]).
 //! - **Peaks**: |u|, |v|, |a| of any node, sampled every [`PEAK_STRIDE`] steps and at the last.
 //! - **Progress**: a bar on stderr when asked for and stderr is a terminal; nothing otherwise.
-//! - **Envelopes**: stress envelopes on face groups ([`super::envelope`], `output.envelope`).
+//! - **Envelopes**: stress envelopes on face groups ([`super::envelope`], `output.envelope`);
+//!   per-node joint envelopes of opening and net slip ([`super::joint_envelope`]).
 //! - **Summary**: [`Recorder::summary`] gathers the [`RunSummary`].
 //!
 //! Velocities and accelerations are the scheme's central differences at t[n]
@@ -130,6 +131,9 @@ pub fn check_outputs(sim: &Simulation<'_>, out_dir: &Path) -> Result<(), Error> 
     }
     for m in &scene.output.monitor {
         claim(format!("histories/{}.csv", stem(&m.name)), format!("monitor \"{}\"", m.name))?;
+    }
+    if !p.joints.is_empty() {
+        claim(super::joint_envelope::JOINT_ENVELOPE_FILE.into(), "the joints' per-node envelopes".into())?;
     }
     for j in &p.joints {
         let (s, who) = (stem(&j.tag.name), format!("joint \"{}\"", j.tag.name));
@@ -339,6 +343,7 @@ impl Recorder {
             peak_acceleration: self.peaks.acceleration.clone(),
             monitors: self.monitors.clone(),
             frames: self.frames.as_ref().map(|f| f.series.len()).unwrap_or(0),
+            blocks: model.materials.iter().map(|m| m.group.clone()).collect(),
             pvd: self.frames.as_ref().map(|f| f.series.path().to_path_buf()),
             histories: self.history.paths().into_iter().chain(self.joints.as_ref().map(|j| j.csv_paths()).unwrap_or_default()).collect(),
             joint_series: self.joints.as_ref().map(|j| j.pvd_paths()).unwrap_or_default(),
@@ -559,6 +564,7 @@ impl Observer for Recorder {
         }
         if let Some(jw) = self.joints.as_mut() {
             jw.flush()?;
+            jw.envelope.write(&self.out_dir)?;
         }
         Ok(())
     }

@@ -54,6 +54,11 @@ pub struct RunSummary {
     pub peak_acceleration: Peak,
     pub monitors: Vec<Monitor>,
     pub frames: usize,
+    /// Per `block_id` of the frames (the material index, scene patterns expanded): its volume
+    /// group, so a reader can name or hide a block (the dam's ParaView state hides the rock).
+    /// Empty in summaries written before it.
+    #[serde(default)]
+    pub blocks: Vec<String>,
     pub out_dir: PathBuf,
     pub pvd: Option<PathBuf>,
     pub histories: Vec<PathBuf>,

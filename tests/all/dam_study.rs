@@ -3,6 +3,7 @@
 //! through the study's own runs.mk with `make` and reported.
 use crate::common::{fixture, scratch};
 use jointquake::output::envelope::StressEnvelope;
+use jointquake::output::joint_envelope::JointEnvelope;
 use jointquake::study::{write_plan, write_report};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -84,7 +85,12 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
         ]}
     ]);
     study["id"] = json!(["method", "level"]);
-    study.as_object_mut().unwrap().remove("runs");
+    // every run, and the study-file switch of the run with frames for ParaView (issue 32; in
+    // pipelines/dam_study.json `nts-default-3x`): NTS, a frame every 0.05 s
+    study["runs"] = json!([
+        {"axes": {"level": "*", "method": "*"}},
+        {"axes": {"level": "0.1x", "method": "nts"}, "with": {"scene": {"/output/frames": true, "/output/frame_interval": 0.05}}}
+    ]);
     let p = dir.join("study.json");
     std::fs::write(&p, serde_json::to_string_pretty(&study).unwrap()).unwrap();
     let (study, kind) = jointquake::studies::load(&p).unwrap();
@@ -245,6 +251,26 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
         assert!(checked > 100, "{checked} faces checked");
         assert!(run.join("envelope.vtu").exists());
     }
+    // the per-node joint envelopes (issue 32): sampled at the joint-history rows, so the
+    // largest value over a joint's nodes is the largest of its history column (to the column's
+    // 10 printed digits: relative 1e-9)
+    for x in [nts, ntn].into_iter().filter(|x| x["failed"].is_null()) {
+        let id = x["id"].as_str().unwrap();
+        let env = JointEnvelope::read(&dir.join(format!("out/runs/{id}"))).unwrap();
+        let res = jointquake::study::StudyResults::read(&study).unwrap();
+        for j in ["J01", "J14", "J28"] {
+            let e = env.joint(j).unwrap_or_else(|| panic!("{id}: no envelope of {j}"));
+            let h = res.run(id).unwrap().joint_history(j).unwrap();
+            let top = |c: &str| h.column(c).unwrap().iter().copied().fold(0.0f64, f64::max);
+            let max = |v: &[f64]| v.iter().copied().fold(0.0f64, f64::max);
+            let near = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-300);
+            let (o, oh) = (max(&e.max_opening), top("max_opening"));
+            let (s, sh) = (max(&e.max_net_slip), top("max_tangential_displacement"));
+            assert!(near(o, oh), "{id} {j}: opening {o} against the history's {oh}");
+            assert!(near(s, sh), "{id} {j}: net slip {s} against the history's {sh}");
+            assert!(e.points.len() > 10, "{id} {j}: {} nodes", e.points.len());
+        }
+    }
     // the report's tables are filled from the runs
     let md = std::fs::read_to_string(&r.report).unwrap();
     let f = |v: f64| jointquake::report::fmt_sig(1e3 * v, 4);
@@ -270,10 +296,72 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
         "{:?}",
         r.charts
     );
+    // the joint maps (issue 32): opening and net slip at the level, NTS and NTN side by side,
+    // at least 900 px wide (the PNG's IHDR width, bytes 16..20)
+    assert!(md.contains("## Joint maps"), "{md}");
+    for q in ["opening", "slip"] {
+        let png = r.charts.iter().find(|c| c.file_name().unwrap() == format!("joint_{q}_0.1x.png").as_str()).unwrap_or_else(|| panic!("no joint {q} map: {:?}", r.charts));
+        let b = std::fs::read(png).unwrap();
+        let width = u32::from_be_bytes([b[16], b[17], b[18], b[19]]);
+        assert!(width >= 900, "{}: {width} px", png.display());
+        assert!(md.contains(&format!("charts/joint_{q}_0.1x.svg")), "embedded: {md}");
+    }
+    // the ParaView state of the run with frames (issue 32): the NTS run's 5 frames (0, 0.05 …
+    // 0.2 s), the rock (block:rock, the last block) hidden, every joint series; its rendering is
+    // checked in ParaView itself by `make test` (scripts/render_pvsm.py)
+    let pvsm = std::fs::read_to_string(dir.join("out/dam.pvsm")).expect("out/dam.pvsm written by the report");
+    let nts_id = nts["id"].as_str().unwrap();
+    let summary = jointquake::study::StudyResults::read(&study).unwrap().run(nts_id).unwrap().summary.clone().unwrap();
+    // t = 0, 0.05, 0.10, 0.15, (0.20 when the whole-step stride fits) and the last step's
+    // t[N] = 0.1998 s: 5 or 6 frames (measured 6)
+    assert!((5..=6).contains(&summary.frames), "a frame every 0.05 s over 0.2 s: {}", summary.frames);
+    let rock = summary.blocks.iter().position(|b| b == "block:rock").expect("the rock block");
+    assert!(pvsm.contains(&format!("runs/{nts_id}/{nts_id}.pvd")), "{pvsm}");
+    assert!(pvsm.contains(&format!("name=\"LowerThreshold\" id=\"101.LowerThreshold\" number_of_elements=\"1\"><Element index=\"0\" value=\"{rock}\"/>")), "{pvsm}");
+    assert_eq!(pvsm.matches("joints/").count(), 29, "28 contraction joints and the base");
+    assert!(md.contains("paraview --state") && md.contains(nts_id), "{md}");
+    // the lost-node split per run (issue 32): a row per contact run
+    assert!(md.contains("beyond the free edge (note)") && md.lines().filter(|l| l.starts_with(&format!("| {nts_id} "))).count() == 1, "{md}");
     // every chart reads at a glance (issue 32): two or more tick labels per axis, none
     // overlapping, a unit on each axis, no text below 12 px
     for c in &r.charts {
         let svg = std::fs::read_to_string(c.with_extension("svg")).unwrap();
         crate::report::assert_readable_svg(&svg, &c.display().to_string());
+    }
+}
+
+#[test]
+fn a_dam_joint_node_slid_past_the_crest_is_beyond_the_free_edge_and_one_over_the_joint_is_inside() {
+    // Issue 32: the dam's joints are classified as the wedge's are (contact::free_edge). On the
+    // coarse fixture's joint J14 (the crown), master side `joint:14:left`: a slave node 2 m above
+    // the crest (its edge node slid up past the curved top edge of the master face), 1 cm off
+    // the face on the slave side, is beyond the free edge; a node over the middle of the joint
+    // (the search failed to place it) is inside. Reference: the geometry (the crest is the
+    // joint's highest free edge); no tolerance (a classification).
+    use jointquake::contact::free_edge::{LostWhere, lost_where, outline_faces};
+    use nalgebra::Vector3;
+    let mesh = jointquake::mesh::Mesh::from_msh(fixture("arch_dam_coarse.msh")).unwrap();
+    let master = jointquake::interface::Surface::from_group(&mesh, "J14", "joint:14:left").unwrap();
+    let all: Vec<u32> = (0..master.faces.len() as u32).collect();
+    let faces = outline_faces(&master, &all, |n| Vector3::from(mesh.nodes[n]));
+    // the face normal of face f, and its centroid
+    let normal = |f: &jointquake::contact::free_edge::OutlineFace| {
+        let c = &f.corners;
+        (c[1] - c[0]).cross(&(c[f.n - 1] - c[0])).normalize()
+    };
+    let centroid = |f: &jointquake::contact::free_edge::OutlineFace| f.corners[..f.n].iter().sum::<Vector3<f64>>() / f.n as f64;
+    let top = faces.iter().max_by(|a, b| centroid(a).z.total_cmp(&centroid(b).z)).unwrap();
+    let mid_z = 0.5 * (faces.iter().map(|f| centroid(f).z).fold(f64::INFINITY, f64::min) + centroid(top).z);
+    let middle = faces.iter().min_by(|a, b| (centroid(a).z - mid_z).abs().total_cmp(&(centroid(b).z - mid_z).abs())).unwrap();
+    for (f, lift, want) in [(top, 2.0, LostWhere::BeyondFreeEdge), (middle, 0.0, LostWhere::Inside)] {
+        // the slave node's normal points into the master: against the master face's normal
+        let n = -normal(f);
+        // `lift` above the face's highest corner (0: at the face's centroid)
+        let top_z = f.corners[..f.n].iter().map(|c| c.z).fold(f64::NEG_INFINITY, f64::max);
+        let mut xs = centroid(f) - 0.01 * n;
+        if lift > 0.0 {
+            xs.z = top_z + lift;
+        }
+        assert_eq!(lost_where(&faces, &xs, &n), want, "node at {xs:?}, face centroid {:?}", centroid(f));
     }
 }

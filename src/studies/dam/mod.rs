@@ -21,6 +21,8 @@
 
 pub mod convergence;
 pub mod face_maps;
+pub mod joint_maps;
+pub mod paraview_state;
 pub mod report;
 pub mod static_table;
 
@@ -56,6 +58,10 @@ pub struct DamParams {
     /// Default 270 (`geo/arch_dam.geo`).
     #[serde(default = "crest_radius")]
     pub crest_radius: f64,
+    /// Material group of the rock, hidden in the ParaView state of the run with frames
+    /// (`paraview_state`). Default `block:rock` (`geo/arch_dam.geo`).
+    #[serde(default = "rock")]
+    pub rock: String,
     /// Relative error within which a cheaper level "is enough". Default 0.10.
     #[serde(default = "enough")]
     pub enough: f64,
@@ -129,6 +135,9 @@ fn mesh_axis() -> String {
 fn crest_radius() -> f64 {
     270.0
 }
+fn rock() -> String {
+    "block:rock".into()
+}
 fn enough() -> f64 {
     0.10
 }
@@ -167,6 +176,11 @@ impl Method {
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct JointDiagnostics {
     pub lost: u64,
+    /// Of `lost`, the node-steps beyond the master's free edge (a note; the rest, lost inside
+    /// its outline, are the warning's: `output::recorder::LOST_WARN_FRACTION`).
+    pub lost_beyond_edge: u64,
+    /// The joint's slave nodes (the scale of the lost fraction).
+    pub slave_nodes: usize,
     pub widened_layer2: u64,
     pub fresh_searches: u64,
     pub max_sweeps: usize,
@@ -413,6 +427,8 @@ impl DamKind {
                         .find(|pk| &pk.name == j)
                         .map(|pk| JointDiagnostics {
                             lost: pk.events.lost,
+                            lost_beyond_edge: pk.events.lost_beyond_edge,
+                            slave_nodes: pk.slave_nodes,
                             widened_layer2: pk.events.widened_layer2,
                             fresh_searches: pk.events.fresh_searches,
                             max_sweeps: pk.max_sweeps,

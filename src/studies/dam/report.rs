@@ -41,7 +41,7 @@ pub struct Accuracy {
     pub error: f64,
 }
 
-fn mm(x: f64) -> String {
+pub(super) fn mm(x: f64) -> String {
     fmt_sig(1e3 * x, 4)
 }
 pub(super) fn mpa(x: f64) -> String {
@@ -159,6 +159,9 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     stress_section(&r, &mut doc);
     stress_against_seed_section(&r, &mut doc);
     super::face_maps::face_maps_section(&r, &mut doc)?;
+    super::joint_maps::joint_maps_section(&r, &mut doc)?;
+    super::paraview_state::paraview_state_section(&r, &mut doc)?;
+    super::joint_maps::lost_nodes_section(&r, &mut doc);
     histories_section(&r, &mut doc)?;
     let claims = claims(kind, &r.runs, &r.levels);
     claims_section(&claims, &mut doc);
@@ -807,7 +810,7 @@ fn search_section(r: &DamReport, doc: &mut Doc) {
     let Some(first) = cols.first() else { return };
     let _ = writeln!(
         doc.md,
-        "Search and Gauss–Seidel per joint at {} (node-steps lost / Layer2 widenings / fresh searches / largest sweeps / unconverged steps; never silent):\n",
+        "Search and Gauss–Seidel per joint at {} (node-steps lost beyond the master's free edge + lost inside its outline / Layer2 widenings / fresh searches / largest sweeps / unconverged steps; never silent):\n",
         lvl(l)
     );
     let mut head = vec!["joint".to_string()];
@@ -825,8 +828,8 @@ fn search_section(r: &DamReport, doc: &mut Doc) {
                 .and_then(|d| r.joints.iter().position(|x| x == j).map(|i| &d[i]));
             row.push(d.map_or("–".into(), |d| {
                 format!(
-                    "{} / {} / {} / {} / {}",
-                    d.lost, d.widened_layer2, d.fresh_searches, d.max_sweeps, d.unconverged_steps
+                    "{} + {} / {} / {} / {} / {}",
+                    d.lost_beyond_edge, d.lost - d.lost_beyond_edge, d.widened_layer2, d.fresh_searches, d.max_sweeps, d.unconverged_steps
                 )
             }));
         }
