@@ -450,6 +450,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let mut u_try = vec![0.0; t.n];
     let mut solver = TangentSolver::new(&k0, &pairs);
     for it in 0..=MAX_ITERATIONS {
+        crate::interrupt::check("the static state (Newton iterations with contact)")?;
         info.residual = evaluate(&uh, &pairs, &mut r, Some(&mut tangents), &mut closed);
         info.iterations = it;
         for (p, &c) in pairs.iter_mut().zip(&closed) {
