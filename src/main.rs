@@ -798,7 +798,9 @@ fn band_of(s: &str) -> Result<[f64; 2]> {
 fn check_option(option: &str, v: f64, (lo, hi): (f64, f64), lo_open: bool, unit: &str) -> Result<()> {
     let above_lo = if lo_open { v > lo } else { v >= lo };
     if !(v.is_finite() && above_lo && v <= hi) {
-        anyhow::bail!("option --{option} = {v}: must be a finite number in {}{lo}, {hi}] {unit}", if lo_open { "(" } else { "[" });
+        // 1e308 as "1e308", not 309 digits
+        let shown = if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
+        anyhow::bail!("option --{option} = {shown}: must be a finite number in {}{lo}, {hi}] {unit}", if lo_open { "(" } else { "[" });
     }
     Ok(())
 }
@@ -832,6 +834,9 @@ impl FitArgs {
     fn check(&self) -> Result<()> {
         check_option("max-iterations", self.max_iterations as f64, (0.0, MAX_FIT_ITERATIONS), false, "")?;
         check_option("tolerance", self.tolerance, (0.0, 1.0), true, "(fraction)")?;
+        if let Some(b) = &self.band {
+            band_of(b)?;
+        }
         check_some("corner", self.baseline.corner, (0.0, 1e3), true, "Hz")
     }
 }

@@ -284,6 +284,11 @@ fn venv_gmsh() -> Option<PathBuf> {
 /// SIGTERM, and return the exit status, stderr and stdout; the process must end within 5 s of
 /// the signal (the phases check the flag within 50 ms to about a second).
 fn sigterm_when(args: &[&str], wait_s: f64, ready: impl Fn() -> bool) -> (std::process::ExitStatus, String, String) {
+    signal_when(args, wait_s, libc::SIGTERM, ready)
+}
+
+/// [`sigterm_when`] with any signal.
+fn signal_when(args: &[&str], wait_s: f64, signal: i32, ready: impl Fn() -> bool) -> (std::process::ExitStatus, String, String) {
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_jointquake")).args(args).stderr(std::process::Stdio::piped()).stdout(std::process::Stdio::piped()).spawn().unwrap();
     let t = std::time::Instant::now();
     while !ready() {
@@ -292,7 +297,7 @@ fn sigterm_when(args: &[&str], wait_s: f64, ready: impl Fn() -> bool) -> (std::p
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
     unsafe {
-        libc::kill(child.id() as i32, libc::SIGTERM);
+        libc::kill(child.id() as i32, signal);
     }
     let t = std::time::Instant::now();
     let status = loop {
@@ -329,7 +334,7 @@ fn sigterm_during_meshing_ends_the_run_and_its_gmsh_child_gmsh() {
     if venv_gmsh().is_none() {
         return;
     }
-    let dir = scratch("hardening/sigterm_gmsh");
+    let dir = scratch("hardening/sigterm_meshing");
     let cache = dir.join("mesh-cache");
     let out = dir.join("out");
     let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam.json");
@@ -340,6 +345,14 @@ fn sigterm_during_meshing_ends_the_run_and_its_gmsh_child_gmsh() {
     std::thread::sleep(std::time::Duration::from_millis(200));
     let left: Vec<String> = processes_mentioning(&c).into_iter().filter(|c| !c.contains("cargo")).collect();
     assert!(left.is_empty(), "gmsh left running: {left:?}");
+    // Issue 34: the gmsh child survived its parent's SIGKILL. It now dies with it
+    // (PR_SET_PDEATHSIG): none left 500 ms after `kill -9` during meshing.
+    let _ = std::fs::remove_dir_all(&cache);
+    let (status, _, _) = signal_when(&["run", scene.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache", &c], 30.0, libc::SIGKILL, || processes_mentioning(&c).iter().any(|p| p.contains("gmsh")));
+    assert_eq!(std::os::unix::process::ExitStatusExt::signal(&status), Some(libc::SIGKILL));
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let left: Vec<String> = processes_mentioning(&c).into_iter().filter(|c| !c.contains("cargo")).collect();
+    assert!(left.is_empty(), "gmsh outlived its parent's SIGKILL: {left:?}");
 }
 
 #[test]
@@ -484,18 +497,18 @@ fn cli_numeric_options_out_of_range_are_refused_naming_the_option() {
         (vec!["record", "info", r, "--g=-9.81", "--out", &o], "--g = -9.81"),
         (vec!["record", "info", r, "--g", "NaN", "--out", &o], "--g = NaN"),
         (vec!["record", "correct", r, "--out", &o, "--g", "inf"], "--g = inf"),
-        (vec!["record", "synth", "--pga", "1e308", "--out", &o], "--pga = 1e308"),
-        (vec!["record", "synth", "--pga", "0.3", "--tg=-1", "--out", &o], "--tg = -1"),
-        (vec!["record", "synth", "--pga", "0.3", "--beta-max", "NaN", "--out", &o], "--beta-max = NaN"),
-        (vec!["record", "synth", "--pga", "0.3", "--max-iterations", "1000000000", "--out", &o], "--max-iterations"),
-        (vec!["record", "synth", "--pga", "0.3", "--tolerance", "NaN", "--out", &o], "--tolerance = NaN"),
-        (vec!["record", "synth", "--pga", "0.3", "--band", "0.1,inf", "--out", &o], "--band = inf"),
-        (vec!["record", "synth", "--pga", "0.3", "--duration", "1e9", "--out", &o], "duration"),
-        (vec!["record", "synth", "--pga", "0.3", "--dt", "1e-300", "--out", &o], "dt"),
-        (vec!["record", "synth", "--pga", "0.3", "--components", "7", "--out", &o], "components"),
-        (vec!["record", "synth", "--pga", "0.3", "--rise", "NaN", "--out", &o], "rise"),
-        (vec!["record", "match", r, "--pga", "NaN", "--out", &o], "--pga = NaN"),
-        (vec!["record", "match", r, "--pga", "0.3", "--out", &o, "--g", "0"], "--g = 0"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "1e308", "--out", &o], "--pga = 1e308"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--tg=-1", "--out", &o], "--tg = -1"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--beta-max", "NaN", "--out", &o], "--beta-max = NaN"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--max-iterations", "1000000000", "--out", &o], "--max-iterations"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--tolerance", "NaN", "--out", &o], "--tolerance = NaN"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--band", "0.1,inf", "--out", &o], "--band = inf"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--duration", "1e9", "--out", &o], "duration"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--dt", "1e-300", "--out", &o], "dt"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--components", "7", "--out", &o], "components"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--rise", "NaN", "--out", &o], "rise"),
+        (vec!["record", "match", r, "--structure", "arch", "--site", "I", "--pga", "NaN", "--out", &o], "--pga = NaN"),
+        (vec!["record", "match", r, "--structure", "arch", "--site", "I", "--pga", "0.3", "--out", &o, "--g", "0"], "--g = 0"),
         (vec!["modes", sc, "--count", "0"], "--count = 0"),
         (vec!["wedge-fs", "--H=-5"], "--H = -5"),
         (vec!["wedge-fs", "--crack", "70/165", "--crack-distance", "NaN"], "--crack-distance = NaN"),
