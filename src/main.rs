@@ -694,8 +694,6 @@ fn cmd_wedge_fs(input: Option<PathBuf>, height_def: Option<HeightDefArg>, h: Opt
             HeightDefArg::CrestOnA => HeightDef::CrestOnA,
         };
     }
-    check_some("H", h, (0.0, 1e4), true, "m")?;
-    check_some("crack-distance", crack_distance, (0.0, 1e4), false, "m")?;
     if let Some(h) = h {
         w.height = h;
     }
