@@ -34,6 +34,20 @@ pub enum Error {
     Study(#[from] StudyError),
     #[error(transparent)]
     Case(#[from] CaseError),
+    /// Ctrl-C, SIGTERM or SIGHUP ended a phase (`crate::interrupt`): not a failure.
+    #[error(transparent)]
+    Interrupted(#[from] crate::interrupt::Interrupted),
+}
+
+impl Error {
+    /// The interrupted phase, when a signal (not the input) ended this stage: an
+    /// [`Error::Interrupted`], or one raised inside a loop that returns a stage's own error.
+    pub fn interrupted(&self) -> Option<&crate::interrupt::Interrupted> {
+        match self {
+            Error::Interrupted(i) | Error::Step(StepError::Interrupted(i)) | Error::Gmsh(GmshError::Interrupted(i)) => Some(i),
+            _ => None,
+        }
+    }
 }
 
 /// Reading a `.msh` file or looking up its parts.
@@ -98,6 +112,9 @@ pub enum StepError {
     /// Reconstructing the massless foundation's displacements (out of memory for the solve).
     #[error("massless foundation: {0}")]
     Foundation(String),
+    /// Ctrl-C or SIGTERM during an iterative static or relaxation loop (`crate::interrupt`).
+    #[error(transparent)]
+    Interrupted(#[from] crate::interrupt::Interrupted),
 }
 
 /// Running the gmsh command line.
@@ -111,6 +128,9 @@ pub enum GmshError {
     MissingGeo { path: PathBuf },
     #[error("cannot write {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
+    /// Ctrl-C or SIGTERM while gmsh ran: the child was ended (`crate::interrupt`).
+    #[error(transparent)]
+    Interrupted(#[from] crate::interrupt::Interrupted),
 }
 
 /// Building joint interfaces (tagger).

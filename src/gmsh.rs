@@ -144,7 +144,7 @@ pub fn mesh_geo(geo: &Path, set: &BTreeMap<String, f64>, cache_dir: &Path) -> Re
     std::fs::write(&log, &all).map_err(|source| GmshError::Io { path: log.clone(), source })?;
     if crate::interrupt::interrupted() {
         let _ = std::fs::remove_file(&tmp);
-        return Err(GmshError::Failed { geo: geo.to_path_buf(), log, message: "interrupted (Ctrl-C or SIGTERM): gmsh was stopped".into() });
+        return Err(crate::interrupt::Interrupted { phase: format!("meshing {} (gmsh was stopped; its log: {})", geo.display(), log.display()) }.into());
     }
     let errors: Vec<&str> = all.lines().filter(|l| l.starts_with("Error")).collect();
     if !status.success() || !errors.is_empty() || !tmp.exists() {

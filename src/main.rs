@@ -544,9 +544,26 @@ struct WedgeFsJson {
 
 fn main() {
     if let Err(e) = real_main() {
+        if interrupted_error(&e) {
+            eprintln!("{}", error_text(&e));
+            std::process::exit(jointquake::interrupt::EXIT_STATUS);
+        }
         eprintln!("error: {}", error_text(&e));
         std::process::exit(1);
     }
+}
+
+/// Whether Ctrl-C or SIGTERM (not the input) ended the command: exit status
+/// `interrupt::EXIT_STATUS` (130) instead of 1, as for an interrupted `run`.
+fn interrupted_error(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| c.downcast_ref::<jointquake::interrupt::Interrupted>().is_some() || c.downcast_ref::<jointquake::Error>().is_some_and(|e| e.interrupted().is_some()))
+}
+
+/// Make Ctrl-C and SIGTERM end the commands whose phases check the flag (`run`, `mesh`, `tag`,
+/// `dam-static`, `study plan`, `study submit`) at the next check, with exit status 130; the
+/// other commands keep the signals' default action (they end at once).
+fn honour_interrupts() -> Result<()> {
+    jointquake::output::recorder::install_interrupt_handler().map_err(anyhow::Error::msg)
 }
 
 /// The context chain joined by ": ", leaving out a cause whose text the messages before it
@@ -569,22 +586,29 @@ fn error_text(e: &anyhow::Error) -> String {
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     match cli.cmd {
-        Cmd::Mesh { scene, cache } => cmd_mesh(&scene.scene, &cache.cache),
+        Cmd::Mesh { scene, cache } => {
+            honour_interrupts()?;
+            cmd_mesh(&scene.scene, &cache.cache)
+        }
         Cmd::Run { io, threads, quiet, duration } => {
             let threads = threads.install()?;
             let scene = io.scene.scene;
             let opts = RunOptions { out_dir: io.out.out, mesh_cache: Some(io.cache.cache), progress: !quiet, duration, threads };
-            jointquake::output::recorder::install_interrupt_handler().map_err(anyhow::Error::msg)?;
+            honour_interrupts()?;
             let summary = jointquake::pipeline::run(&scene, &opts).with_context(|| format!("running scene {}", scene.display()))?;
             say_raw!("{}", summary.to_text());
             if summary.interrupted.is_some() {
-                std::process::exit(130);
+                std::process::exit(jointquake::interrupt::EXIT_STATUS);
             }
             Ok(())
         }
         Cmd::Modes { io, count, json } => cmd_modes(&io.scene.scene, count, io.out.out, &io.cache.cache, json),
-        Cmd::DamStatic { io } => cmd_dam_static(&io.scene.scene, io.out.out, io.cache.cache),
+        Cmd::DamStatic { io } => {
+            honour_interrupts()?;
+            cmd_dam_static(&io.scene.scene, io.out.out, io.cache.cache)
+        }
         Cmd::Tag { scene, out, cache, json } => {
+            honour_interrupts()?;
             let opts = RunOptions { out_dir: out, mesh_cache: Some(cache.cache), progress: false, duration: None, threads: None };
             let summary = jointquake::pipeline::tag(&scene, &opts).with_context(|| format!("tagging the joints of scene {}", scene.display()))?;
             if json {
@@ -613,8 +637,13 @@ fn cmd_mesh(scene: &Path, cache: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Most modes `modes --count` computes: 1000 (the dam's studies use 6–20; each mode is a
+/// vector of the model's size and an eigen iteration).
+const MAX_MODES: f64 = 1000.0;
+
 /// `jointquake modes`: the lowest `count` modes of the scene's model.
 fn cmd_modes(scene: &Path, count: usize, out: Option<PathBuf>, cache: &Path, json: bool) -> Result<()> {
+    check_option("count", count as f64, (1.0, MAX_MODES), false, "modes")?;
     let mut s = jointquake::scene::Scene::load(scene).with_context(|| format!("loading scene {}", scene.display()))?;
     let mesh = jointquake::pipeline::load_scene_mesh(&mut s, scene, Some(cache)).with_context(|| format!("meshing scene {}", scene.display()))?;
     let out_dir = out.unwrap_or_else(|| s.output_dir());
@@ -643,6 +672,9 @@ fn cmd_dam_static(scene: &Path, out: Option<PathBuf>, cache: PathBuf) -> Result<
     if let Some((md, path)) = table_md {
         say!("{md}");
         say!("static table: {}", path.display());
+    }
+    if summary.interrupted.is_some() {
+        std::process::exit(jointquake::interrupt::EXIT_STATUS);
     }
     Ok(())
 }
@@ -750,13 +782,81 @@ fn target_of(a: &TargetArgs) -> Result<jointquake::motion::TargetSpec> {
 
 fn band_of(s: &str) -> Result<[f64; 2]> {
     let (a, b) = s.split_once(',').with_context(|| format!("--band {s:?}: expected LO,HI in seconds, e.g. 0.1,3.0"))?;
-    Ok([a.trim().parse().with_context(|| format!("--band {s:?}: {a:?} is not a number"))?, b.trim().parse().with_context(|| format!("--band {s:?}: {b:?} is not a number"))?])
+    let band: [f64; 2] = [a.trim().parse().with_context(|| format!("--band {s:?}: {a:?} is not a number"))?, b.trim().parse().with_context(|| format!("--band {s:?}: {b:?} is not a number"))?];
+    for v in band {
+        check_option("band", v, (0.0, 100.0), true, "s (each end)")?;
+    }
+    Ok(band)
+}
+
+/// A numeric command-line option checked before anything is read or written: finite and in
+/// `[lo, hi]` (the bounds docs/cli.md states next to the option; `lo_open`: `lo` itself
+/// excluded). The error names the option, its value, the range and the unit (issue 34:
+/// `record info --g -9.81` was accepted; NaN or inf options became the defaults).
+fn check_option(option: &str, v: f64, (lo, hi): (f64, f64), lo_open: bool, unit: &str) -> Result<()> {
+    let above_lo = if lo_open { v > lo } else { v >= lo };
+    if !(v.is_finite() && above_lo && v <= hi) {
+        // 1e308 as "1e308", not 309 digits
+        let shown = if v.is_finite() && v != 0.0 && !(1e-4..1e6).contains(&v.abs()) { format!("{v:e}") } else { format!("{v}") };
+        anyhow::bail!("option --{option} = {shown}: must be a finite number in {}{lo}, {hi}] {unit}", if lo_open { "(" } else { "[" });
+    }
+    Ok(())
+}
+
+/// [`check_option`] for an option that may be absent.
+fn check_some(option: &str, v: Option<f64>, range: (f64, f64), lo_open: bool, unit: &str) -> Result<()> {
+    v.map_or(Ok(()), |v| check_option(option, v, range, lo_open, unit))
+}
+
+/// Standard gravity accepted by `--g` [m/s²]: (0, 100] (Earth 9.81; a typo such as 981 or a
+/// sign is refused).
+const G_RANGE: (f64, f64) = (0.0, 100.0);
+/// Largest PGA an option accepts [g]: 10 (the largest recorded are about 4 g).
+const MAX_PGA_G: f64 = 10.0;
+/// Largest `--max-iterations` of spectral matching: 10 000 (the defaults converge in under 100;
+/// each iteration is a full response spectrum).
+const MAX_FIT_ITERATIONS: f64 = 10_000.0;
+
+impl TargetArgs {
+    /// The code-spectrum numbers: `--basic-tg`, `--tg` (0, 10] s and `--beta-max` (0, 10].
+    fn check(&self) -> Result<()> {
+        check_some("basic-tg", self.basic_tg, (0.0, 10.0), true, "s")?;
+        check_some("tg", self.tg, (0.0, 10.0), true, "s")?;
+        check_some("beta-max", self.beta_max, (0.0, 10.0), true, "(amplification)")
+    }
+}
+
+impl FitArgs {
+    /// `--max-iterations` in [0, 10 000] and a finite `--tolerance` (its range is the
+    /// synthesis's own check) and `--corner` (checked against the Nyquist frequency there).
+    fn check(&self) -> Result<()> {
+        check_option("max-iterations", self.max_iterations as f64, (0.0, MAX_FIT_ITERATIONS), false, "")?;
+        check_option("tolerance", self.tolerance, (0.0, 1.0), true, "(fraction)")?;
+        if let Some(b) = &self.band {
+            band_of(b)?;
+        }
+        check_some("corner", self.baseline.corner, (0.0, 1e3), true, "Hz")
+    }
 }
 
 fn record_cmd(action: RecordCmd) -> Result<()> {
     use jointquake::dynamics::record::Record;
     use jointquake::motion::{commands, synth};
     let stem = |p: &PathBuf| p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "record".into());
+    match &action {
+        RecordCmd::Info { g, .. } | RecordCmd::Correct { g, .. } => check_option("g", *g, G_RANGE, true, "m/s²")?,
+        RecordCmd::Synth { target, pga, fit, .. } => {
+            check_option("pga", *pga, (0.0, MAX_PGA_G), true, "g")?;
+            target.check()?;
+            fit.check()?;
+        }
+        RecordCmd::Match { target, pga, fit, g, .. } => {
+            check_option("g", *g, G_RANGE, true, "m/s²")?;
+            check_option("pga", *pga, (0.0, MAX_PGA_G), true, "g")?;
+            target.check()?;
+            fit.check()?;
+        }
+    }
     match action {
         RecordCmd::Info { files, out, g } => {
             for f in &files {
@@ -814,6 +914,7 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
     let load = |p: &PathBuf| jointquake::studies::load(p).with_context(|| format!("loading study {}", p.display()));
     match action {
         StudyCmd::Plan { study: path, cache, bin } => {
+            honour_interrupts()?;
             let (s, kind) = load(&path)?;
             let files = study::write_plan(&s, &kind.steps(), &cache.cache, &bin).with_context(|| format!("planning study {}", path.display()))?;
             say!(
@@ -836,6 +937,7 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
             };
             let opts = slurm::SlurmOptions { partition, time, cpus_per_run, max_parallel, bin, cache: cache.cache };
             opts.check()?;
+            honour_interrupts()?;
             let (s, kind) = load(&path)?;
             study::write_plan(&s, &kind.steps(), &opts.cache, &opts.bin.display().to_string()).with_context(|| format!("planning study {}", path.display()))?;
             let plan = study::Plan::read(&s.out)?;

@@ -65,7 +65,7 @@ pub fn load_scene_mesh(scene: &mut Scene, scene_path: &Path, mesh_cache: Option<
 /// Ends a run between its phases when SIGINT/SIGTERM arrived (`crate::interrupt`), naming the
 /// phase that had finished.
 fn interrupt_phase(name: &str) -> Result<(), Error> {
-    crate::interrupt::check(name).map_err(|m| ModelError::Invalid(m).into())
+    Ok(crate::interrupt::check(name)?)
 }
 
 /// Expand the scene's group patterns against the mesh ([`crate::scene::patterns`]) and check
@@ -88,6 +88,15 @@ pub fn run(scene_path: &Path, opts: &RunOptions) -> Result<RunSummary, Error> {
 
 /// [`run`], with `inspect` called on the simulation and the output directory after the static
 /// state (the equilibrium), before the dynamic stage (e.g. the dam's static table).
+///
+/// Ctrl-C or SIGTERM (`crate::interrupt`) in any phase ends the run with `Ok` and a
+/// `summary.json` marked `interrupted`: in the time loop at its next output (the recorder's
+/// summary, outputs whole up to there); before it (meshing, pattern expansion, the model's build,
+/// the static state) at the phase's next check, with a summary naming the phase
+/// ([`RunSummary::interrupted_before`]). The CLI exits with `crate::interrupt::EXIT_STATUS`
+/// for both. A run whose joints penetrate beyond the stated fraction of their element size
+/// ([`crate::output::recorder::penetration_excess`]) writes its outputs and summary, then is an
+/// error unless the scene sets `output.allow_penetration`.
 pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMut(&Simulation<'_>, &Path) -> Result<(), Error> + Send)) -> Result<RunSummary, Error> {
     let t_all = Instant::now();
     let mut laps = Laps::start();
@@ -98,6 +107,26 @@ pub fn run_inspect(scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMu
         }
         scene.time.duration = d;
     }
+    let (name, out_dir, allow_penetration) = (scene.name().to_string(), opts.out_dir.clone().unwrap_or_else(|| scene.output_dir()), scene.output.allow_penetration);
+    match run_phases(scene, scene_path, opts, inspect, &mut laps, t_all) {
+        Err(e) if e.interrupted().is_some() => {
+            let phase = e.interrupted().map(|i| i.phase.clone()).unwrap_or_default();
+            laps.lap(&format!("interrupted during {phase}"));
+            let summary = RunSummary::interrupted_before(&name, &out_dir, &phase, laps.timings.clone(), t_all.elapsed().as_secs_f64());
+            std::fs::create_dir_all(&out_dir).map_err(|e| crate::error::OutputError::write(&out_dir, e))?;
+            summary.write(&out_dir)?;
+            Ok(summary)
+        }
+        Ok(summary) if !allow_penetration && summary.interrupted.is_none() => match crate::output::recorder::penetration_excess(&summary.joints) {
+            Some(m) => Err(crate::error::StepError::Contact(format!("{m}; the outputs and summary.json are in {} (set `output.allow_penetration: true` in the scene to accept such a run)", out_dir.display())).into()),
+            None => Ok(summary),
+        },
+        r => r,
+    }
+}
+
+/// The phases of [`run_inspect`] after the scene is read: mesh, problem, static state, time loop.
+fn run_phases(mut scene: Scene, scene_path: &Path, opts: &RunOptions, inspect: &mut (dyn FnMut(&Simulation<'_>, &Path) -> Result<(), Error> + Send), laps: &mut Laps, t_all: Instant) -> Result<RunSummary, Error> {
     let mesh = load_scene_mesh(&mut scene, scene_path, opts.mesh_cache.as_deref())?;
     let mesh_path = mesh.source.clone();
     laps.lap("mesh");

@@ -749,9 +749,9 @@ impl ContactSolver<'_> {
                             // beyond the master's free edge (expected) or lost inside it
                             self.candidates_into(j, rec.pairs[i].center, 2);
                             let near = free_edge::outline_faces(&j.tag.master, &self.cand, |g| pos(model, conf, g));
-                            if free_edge::lost_where(&near, &xs, &j.frames[i][0]) == free_edge::LostWhere::BeyondFreeEdge {
-                                rec.events.lost_beyond_edge += 1;
-                            }
+                            let beyond = free_edge::lost_where(&near, &xs, &j.frames[i][0]) == free_edge::LostWhere::BeyondFreeEdge;
+                            rec.pairs[i].beyond_edge = beyond;
+                            rec.events.lost_beyond_edge += u64::from(beyond);
                             continue;
                         }
                     },

@@ -28,6 +28,10 @@ pub struct PairRecord {
     /// unless the joint was grouted, where it is the gap at grouting (a construction
     /// sequence's stage, `construction`), so the grouted joint starts closed with no force.
     pub gap_offset: f64,
+    /// Whether the node, lost in the last step (gap NaN), lay beyond the master surface's free
+    /// edge (`super::free_edge`: it slid off the surface) rather than inside its outline; false
+    /// while it finds a face. Its travel then counts as no penetration in the outputs.
+    pub beyond_edge: bool,
 }
 
 /// Counters of search events per joint.
@@ -96,6 +100,7 @@ impl ContactState {
                             d_t: [0.0; 2],
                             slip: 0.0,
                             gap_offset: 0.0,
+                            beyond_edge: false,
                         })
                         .collect(),
                     ..Default::default()

@@ -596,6 +596,7 @@ pub fn relax_gravity(
     let mut residual = f64::INFINITY;
     let mut alpha = 0.0;
     for k in 0..max_steps {
+        crate::interrupt::check_every(k, "the static state (gravity relaxation)")?;
         let scale = ((k + 1) as f64 / RELAXATION_RAMP_STEPS as f64).min(1.0);
         solver.step(model, loads, state, Stage::Relaxation(alpha, scale), &mut *constraints)?;
         // after the step: u_nm1 = u[n−1], u_prev = u[n], u = u[n+1]; f_int = K u[n].

@@ -182,7 +182,7 @@ impl JointWriter {
     /// Per slave node of joint `k`: its `lost_travel` [m] (0 when in contact) at displacement
     /// `u`, and its penetration estimated against the master surface it left: the travel since
     /// it was last in contact along its slave normal n (into the master), max(0, n · Δ) [m],
-    /// the gap then taken as closed. A lost node has no projection, so its penetration was not
+    /// the gap then taken as closed (0 for a node lost beyond the master's free edge). A lost node has no projection, so its penetration was not
     /// measured at all: a block sank 3.73 m with a summary "max penetration 6.6e-24 m" (issue
     /// 34). Moves the anchors of the nodes in contact.
     fn lost_travel(&mut self, k: usize, j: &ContactJoint, r: &JointRecord, u: &[f64]) -> Vec<(f64, f64)> {
@@ -198,7 +198,9 @@ impl JointWriter {
                     let a = anchor[i];
                     let d = [rel[0] - a[0], rel[1] - a[1], rel[2] - a[2]];
                     let n = j.frames[i][0];
-                    ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]).max(0.0))
+                    // beyond the free edge it slid off the surface: nothing there to penetrate
+                    let pen = if r.pairs[i].beyond_edge { 0.0 } else { (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]).max(0.0) };
+                    ((d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), pen)
                 } else {
                     (0.0, 0.0)
                 }

@@ -74,6 +74,11 @@ pub struct RunSummary {
     /// outputs up to there are whole).
     #[serde(default)]
     pub interrupted: Option<f64>,
+    /// Set when the signal came before the time loop: the phase it ended ("meshing", "the
+    /// static state", …). `interrupted` is then 0 and the counts, peaks and outputs are empty
+    /// (nothing of them was computed), see [`RunSummary::interrupted_before`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interrupted_phase: Option<String>,
     /// Time between two history rows [s] (`output.history_stride` / `history_interval`).
     #[serde(default)]
     pub history_rows_every: f64,
@@ -135,10 +140,11 @@ impl Provenance {
 }
 
 impl RunSummary {
-    /// Write `summary.json` into `out_dir` (whole, pretty-printed).
+    /// Write `summary.json` into `out_dir` (whole, pretty-printed: `files::write_whole`, so a
+    /// full disk leaves the previous file or none, never half of one).
     pub fn write(&self, out_dir: &Path) -> Result<PathBuf, OutputError> {
         let sp = out_dir.join("summary.json");
-        std::fs::write(&sp, serde_json::to_string_pretty(self).expect("summary serialises")).map_err(|e| OutputError::write(&sp, e))?;
+        crate::files::write_whole(&sp, serde_json::to_string_pretty(self).expect("summary serialises").as_bytes()).map_err(|(p, m)| OutputError::write(p, m))?;
         Ok(sp)
     }
 
@@ -149,10 +155,64 @@ impl RunSummary {
         serde_json::from_str(&text).map_err(|e| OutputError::read(&file, format!("not a run summary: {e}")))
     }
 
+    /// The summary of a run that Ctrl-C or SIGTERM ended before its time loop, during `phase`:
+    /// the scene, the output directory, the stage times and the phase; `interrupted` = 0 s and
+    /// every count, peak and output empty (none was computed). Written as `summary.json` like a
+    /// finished run's, so a study reads the run as interrupted, not as missing.
+    pub fn interrupted_before(scene: &str, out_dir: &Path, phase: &str, timings: Vec<(String, f64)>, wall_time: f64) -> RunSummary {
+        RunSummary {
+            scene: scene.to_string(),
+            mesh: PathBuf::new(),
+            nodes: 0,
+            elements: 0,
+            tets: 0,
+            hexes: 0,
+            hex_shapes: 0,
+            dt: 0.0,
+            dt_stable: 0.0,
+            critical_element: 0,
+            critical_group: String::new(),
+            critical_scaled_jacobian: None,
+            critical_step_ratio: None,
+            mass_scaling: None,
+            steps: 0,
+            duration: 0.0,
+            threads: rayon::current_num_threads(),
+            equilibrium: None,
+            energy: Energy::default(),
+            peak_displacement: Peak::default(),
+            peak_velocity: Peak::default(),
+            peak_acceleration: Peak::default(),
+            monitors: Vec::new(),
+            frames: 0,
+            blocks: Vec::new(),
+            out_dir: out_dir.to_path_buf(),
+            pvd: None,
+            histories: Vec::new(),
+            joint_series: Vec::new(),
+            joints: Vec::new(),
+            notes: Vec::new(),
+            timings,
+            wall_time,
+            interrupted: Some(0.0),
+            interrupted_phase: Some(phase.to_string()),
+            history_rows_every: 0.0,
+            warnings: Vec::new(),
+            provenance: Some(Provenance::of_this_process()),
+        }
+    }
+
     /// One screen of text for the end of a run.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
         use std::fmt::Write as _;
+        if let Some(phase) = &self.interrupted_phase {
+            let _ = writeln!(s, "scene {}: INTERRUPTED (Ctrl-C or SIGTERM) during {phase}, before the time loop: nothing after it was computed", self.scene);
+            let t: Vec<String> = self.timings.iter().map(|(k, v)| format!("{k} {v:.2} s")).collect();
+            let _ = writeln!(s, "  wall time       {:.2} s ({})", self.wall_time, t.join(", "));
+            let _ = writeln!(s, "  summary         {}", self.out_dir.join("summary.json").display());
+            return s;
+        }
         let _ = writeln!(s, "scene {}: {} nodes, {} elements ({} tet4, {} hex8 in {} shapes)", self.scene, self.nodes, self.elements, self.tets, self.hexes, self.hex_shapes);
         let _ = writeln!(s, "  mesh            {}", self.mesh.display());
         let _ = writeln!(

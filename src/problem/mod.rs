@@ -28,6 +28,9 @@ pub struct Problem {
     pub loads: Loads,
     /// Notes of the build (records read and scaled, snapped loads).
     pub notes: Vec<String>,
+    /// What the build accepted but a user should look at (a pool level far above the wet
+    /// faces): copied into the run summary's warnings.
+    pub warnings: Vec<String>,
     /// The radiating foundation's far boundary (`None` for the other foundation models).
     pub far_boundary: Option<foundation::radiating::FarBoundary>,
     /// The acoustic water of `reservoir.model: "acoustic"` (`None` for the other models).
@@ -52,15 +55,19 @@ impl Problem {
     pub fn from_model(scene: Scene, model: Model) -> Result<Problem, Error> {
         let joints = build_joints(&model.mesh, &scene)?;
         let (mut loads, mut notes) = Loads::build(&model, &scene)?;
-        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic) {
+        let mut warnings = Vec::new();
+        if let Some(r) = scene.reservoir.as_ref().filter(|r| r.hydrostatic || r.added_mass) {
             let (faces, spec) = reservoir::wet_faces_of_scene(&model.mesh, &scene, r)?;
-            loads.static_forces = reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
-            let total: f64 = loads.static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
-            notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), loads.static_forces.len(), total));
+            warnings.extend(reservoir::pool_level_warning(&model.mesh, &faces, &spec));
+            if r.hydrostatic {
+                loads.static_forces = reservoir::hydrostatic_forces(&model.mesh, &faces, &spec);
+                let total: f64 = loads.static_forces.iter().map(|(_, f)| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()).sum();
+                notes.push(format!("reservoir: pool level {:.3} m, depth {:.3} m, hydrostatic on {} nodes (Σ|f| {:.4e} N)", spec.level, spec.depth(), loads.static_forces.len(), total));
+            }
         }
         let far_boundary = foundation::massed::prepare_loads(&scene, &model, &mut loads, &mut notes)?;
         let water = reservoir::acoustic_water_of_scene(&model.mesh, &scene)?;
-        Ok(Problem { scene, model, joints, loads, notes, far_boundary, water })
+        Ok(Problem { scene, model, joints, loads, notes, warnings, far_boundary, water })
     }
 }
 

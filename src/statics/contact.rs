@@ -495,6 +495,7 @@ fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, info: &mut StaticCo
     let mut u_try = vec![0.0; n];
     let mut solver = TangentSolver::new(k0, pairs);
     for it in 0..=MAX_ITERATIONS {
+        crate::interrupt::check("the static state (Newton iterations with contact)")?;
         info.residual = residual.evaluate_into(&uh, pairs, &mut r, Some(&mut tangents), &mut closed);
         info.iterations = it;
         for (p, &c) in pairs.iter_mut().zip(&closed) {

@@ -406,6 +406,7 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
     let mut meshes: Vec<PathBuf> = Vec::new();
     let mut changed = 0;
     for r in &runs {
+        crate::interrupt::check("the planning of the study (its scenes and meshes)")?;
         let s = variant_scene(study, &base_v, &r.labels, &r.overrides, &r.id)?;
         if let Some(geo) = &s.geometry.geo {
             let m = crate::gmsh::mesh_geo(geo, &s.geometry.set, mesh_cache)?;

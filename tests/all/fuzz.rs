@@ -231,7 +231,7 @@ fn full_numeric_scene() -> serde_json::Value {
         "equilibrium": {"tolerance": 1e-6, "max_residual": 1e-3, "max_steps": 2000},
         "output": {"frames": false, "history_interval": 1e-4, "monitor": [{"name": "m", "point": [0, 0, 0.5]}]},
         "joints": [{"name": "J", "master": "joint:J:lower", "slave": "joint:J:upper", "mu": 0.6, "cohesion": 0.0, "tensile_strength": 0.0, "edge_tolerance": 1e-3}],
-        "reservoir": {"faces": ["joint:J:upper"], "level": 1.0, "rho_w": 1000.0},
+        "reservoir": {"faces": ["joint:J:upper"], "level": 1.5, "rho_w": 1000.0},
         "g": 9.81
     })
 }
@@ -410,4 +410,53 @@ fn fuzz_repeated_groups_and_non_regular_targets() {
         Ok(())
     });
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "keep");
+}
+
+/// Issue 34: output file names that collide (a monitor `joint_J` and a joint `J` both wrote
+/// `histories/joint_J.csv`) are refused before the run, and only then. Random joint and
+/// monitor names from a pool built to collide after the stem rule (`joint_J`, `J_forces`,
+/// `a/b` and `a_b`, …), with and without the joint-force histories: the run (0 s, the boxes)
+/// fails naming "unique" exactly when two of the files the reference below lists coincide
+/// (or the scene refuses a name for itself); otherwise each of those files exists and holds
+/// the header of its one writer.
+#[test]
+fn fuzz_colliding_output_names_are_refused_before_the_run() {
+    use jointquake::files::file_stem;
+    use jointquake::pipeline::{run, RunOptions};
+    let dir = scratch("fuzz/collisions");
+    let p = dir.join("scene.json");
+    let pool = vec!["J", "joint_J", "joint_J_forces", "J_forces", "a/b", "a_b", "a b", "x", "joint_x", "summary"];
+    let name = proptest::sample::select(pool);
+    fuzz_values("collisions", 17, (cases() / 20).max(10), (name.clone(), proptest::collection::vec(name, 0..4), any::<bool>()), |(joint, monitors, forces)| {
+        let mut s = full_numeric_scene();
+        s["reservoir"] = serde_json::Value::Null;
+        s["loads"] = serde_json::json!({});
+        s["time"] = serde_json::json!({"duration": 0.0});
+        s["joints"][0]["name"] = serde_json::json!(joint);
+        s["output"] = serde_json::json!({"frames": false, "joint_forces": forces, "monitor": monitors.iter().map(|m| serde_json::json!({"name": m, "point": [0, 0, 0.5]})).collect::<Vec<_>>()});
+        std::fs::write(&p, serde_json::to_string(&s).unwrap()).unwrap();
+        // the reference: every history file and its writer's header line
+        let mut files: Vec<(String, &str)> = monitors.iter().map(|m| (format!("{}.csv", file_stem(m)), jointquake::output::history::MONITOR_HEADER)).collect();
+        files.push((format!("joint_{}.csv", file_stem(joint)), jointquake::output::joints::JOINT_HEADER));
+        if forces {
+            files.push((format!("joint_{}_forces.csv", file_stem(joint)), jointquake::output::joints::JOINT_FORCES_HEADER));
+        }
+        let collide = files.iter().enumerate().any(|(i, f)| files[..i].iter().any(|g| g.0 == f.0));
+        let out = dir.join("out");
+        let _ = std::fs::remove_dir_all(&out);
+        match run(&p, &RunOptions { out_dir: Some(out.clone()), ..Default::default() }) {
+            Err(e) => {
+                let (m, by_scene) = (e.to_string(), jointquake::scene::Scene::load(&p).is_err());
+                prop_assert!(by_scene || (collide && (m.contains("unique") || m.contains("two monitors are named"))), "collide {collide}: {m}");
+            }
+            Ok(_) => {
+                prop_assert!(!collide, "accepted colliding names: joint {joint:?}, monitors {monitors:?}");
+                for (f, header) in &files {
+                    let text = std::fs::read_to_string(out.join("histories").join(f)).unwrap_or_default();
+                    prop_assert_eq!(text.lines().next(), Some(*header), "{}", f);
+                }
+            }
+        }
+        Ok(())
+    });
 }

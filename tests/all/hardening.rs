@@ -256,41 +256,307 @@ fn processes_mentioning(needle: &str) -> Vec<String> {
     out
 }
 
-#[test]
-#[ignore = "runs gmsh (make test runs it): cargo test --test all -- --ignored gmsh"]
-fn sigterm_during_meshing_ends_the_run_and_its_gmsh_child_gmsh() {
-    // Before: the first SIGTERM was ignored until the time loop, and the gmsh child outlived
-    // its parent. The arch dam's default mesh takes gmsh several seconds: SIGTERM after 1.5 s
-    // must end jointquake within 5 s (poll 50 ms, then the phase check), with "interrupted"
-    // and the phase, and leave no gmsh child (its command line names the mesh cache below).
-    let dir = scratch("hardening/sigterm_gmsh");
-    let cache = dir.join("mesh-cache");
-    let _ = std::fs::remove_dir_all(&cache);
-    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam.json");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_jointquake"))
-        .args(["run", scene.to_str().unwrap(), "--quiet", "--out", dir.join("out").to_str().unwrap(), "--cache", cache.to_str().unwrap()])
-        .stderr(std::process::Stdio::piped())
-        .stdout(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    assert!(!processes_mentioning(cache.to_str().unwrap()).is_empty(), "gmsh should be meshing");
+/// The venv's gmsh launcher, or `None` with a note (a failure under `make test`, which sets
+/// JQ_REQUIRE_VENV), as the other gmsh checks skip.
+fn venv_gmsh() -> Option<PathBuf> {
+    let g = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/gmsh");
+    if g.exists() {
+        return Some(g);
+    }
+    assert!(std::env::var_os("JQ_REQUIRE_VENV").is_none(), "{} is missing (make venv)", g.display());
+    eprintln!("note: {} absent, the SIGTERM-during-meshing check is skipped", g.display());
+    None
+}
+
+/// Start `jointquake args`, wait until `ready` holds (polled every 20 ms, at most `wait_s`), send
+/// SIGTERM, and return the exit status, stderr and stdout; the process must end within 5 s of
+/// the signal (the phases check the flag within 50 ms to about a second).
+fn sigterm_when(args: &[&str], wait_s: f64, ready: impl Fn() -> bool) -> (std::process::ExitStatus, String, String) {
+    signal_when(args, wait_s, libc::SIGTERM, ready)
+}
+
+/// [`sigterm_when`] with any signal.
+fn signal_when(args: &[&str], wait_s: f64, signal: i32, ready: impl Fn() -> bool) -> (std::process::ExitStatus, String, String) {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_jointquake")).args(args).stderr(std::process::Stdio::piped()).stdout(std::process::Stdio::piped()).spawn().unwrap();
+    let t = std::time::Instant::now();
+    while !ready() {
+        assert!(t.elapsed().as_secs_f64() < wait_s, "the phase to interrupt was not reached within {wait_s} s");
+        assert!(child.try_wait().unwrap().is_none(), "ended before the phase to interrupt");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
     unsafe {
-        libc::kill(child.id() as i32, libc::SIGTERM);
+        libc::kill(child.id() as i32, signal);
     }
     let t = std::time::Instant::now();
     let status = loop {
         if let Some(s) = child.try_wait().unwrap() {
             break s;
         }
-        assert!(t.elapsed().as_secs_f64() < 5.0, "still running 5 s after SIGTERM");
-        std::thread::sleep(std::time::Duration::from_millis(50));
+        if t.elapsed().as_secs_f64() > 5.0 {
+            let _ = child.kill();
+            panic!("still running 5 s after SIGTERM");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
     };
-    let mut err = String::new();
+    let (mut err, mut out) = (String::new(), String::new());
     std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
-    assert!(!status.success());
-    assert_mentions(&err, &["interrupted"]);
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut out).unwrap();
+    (status, err, out)
+}
+
+/// The summary an interrupted run leaves: marked `interrupted`, naming the phase.
+fn assert_interrupted_summary(out: &Path, phase: &str) {
+    let s = jointquake::output::summary::RunSummary::read(out).unwrap();
+    assert_eq!(s.interrupted, Some(0.0));
+    let p = s.interrupted_phase.unwrap_or_default();
+    assert!(p.contains(phase), "phase {p:?}, expected {phase:?}");
+}
+
+#[test]
+fn sigterm_during_meshing_ends_the_run_and_its_gmsh_child_gmsh() {
+    // Before: the first SIGTERM was ignored until the time loop, and the gmsh child outlived
+    // its parent. The arch dam's default mesh takes gmsh several seconds: SIGTERM once gmsh
+    // runs must end jointquake within 5 s (poll 50 ms, then the phase check) with exit status
+    // 130 (interrupt::EXIT_STATUS), a summary.json marked interrupted during meshing, and no
+    // gmsh child left (its command line names the mesh cache below).
+    if venv_gmsh().is_none() {
+        return;
+    }
+    let dir = scratch("hardening/sigterm_meshing");
+    let cache = dir.join("mesh-cache");
+    let out = dir.join("out");
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/dam.json");
+    let c = cache.to_str().unwrap().to_string();
+    let (status, err, _) = sigterm_when(&["run", scene.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache", &c], 30.0, || processes_mentioning(&c).iter().any(|p| p.contains("gmsh")));
+    assert_eq!(status.code(), Some(jointquake::interrupt::EXIT_STATUS), "{err}");
+    assert_interrupted_summary(&out, "meshing");
     std::thread::sleep(std::time::Duration::from_millis(200));
-    let left: Vec<String> = processes_mentioning(cache.to_str().unwrap()).into_iter().filter(|c| !c.contains("cargo")).collect();
+    let left: Vec<String> = processes_mentioning(&c).into_iter().filter(|c| !c.contains("cargo")).collect();
     assert!(left.is_empty(), "gmsh left running: {left:?}");
+    // Issue 34: the gmsh child survived its parent's SIGKILL. It now dies with it
+    // (PR_SET_PDEATHSIG): none left 500 ms after `kill -9` during meshing.
+    let _ = std::fs::remove_dir_all(&cache);
+    let (status, _, _) = signal_when(&["run", scene.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap(), "--cache", &c], 30.0, libc::SIGKILL, || processes_mentioning(&c).iter().any(|p| p.contains("gmsh")));
+    assert_eq!(std::os::unix::process::ExitStatusExt::signal(&status), Some(libc::SIGKILL));
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let left: Vec<String> = processes_mentioning(&c).into_iter().filter(|c| !c.contains("cargo")).collect();
+    assert!(left.is_empty(), "gmsh outlived its parent's SIGKILL: {left:?}");
+}
+
+#[test]
+fn sigterm_during_the_static_state_ends_with_an_interrupted_summary_and_130() {
+    // Before: the gravity relaxation read no flag, so SIGTERM waited for equilibrium.max_steps.
+    // The column under gravity with a tolerance it never reaches (1e-300) and 10⁹ allowed
+    // steps relaxes for many minutes; SIGTERM 1 s in must end it within 5 s (the flag is read
+    // every interrupt::CHECK_EVERY = 100 steps) with status 130 and summary.json marked
+    // interrupted during the static state, no frames or histories written.
+    let dir = scratch("hardening/sigterm_static");
+    let mut sc = column_scene();
+    sc["loads"] = json!({"gravity": {}});
+    sc["equilibrium"] = json!({"tolerance": 1e-300, "max_residual": 0.9, "max_steps": 1_000_000_000u64});
+    let (p, _) = write_scene("sigterm_static", &sc);
+    let out = dir.join("out");
+    let t = std::time::Instant::now();
+    let (status, err, stdout) = sigterm_when(&["run", p.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()], 10.0, || t.elapsed().as_secs_f64() > 1.0);
+    assert_eq!(status.code(), Some(jointquake::interrupt::EXIT_STATUS), "{err}");
+    assert_mentions(&stdout, &["INTERRUPTED", "static state"]);
+    assert_interrupted_summary(&out, "static state");
+    assert!(!out.join("histories").exists(), "histories written after an interrupt before the time loop");
+}
+
+#[test]
+fn sigterm_during_the_planning_of_a_study_ends_with_130_before_the_plan_is_written() {
+    // Before: `study plan` installed no handler and checked no flag. 10 000 runs (the limit,
+    // study::plan::MAX_STUDY_RUNS) of the column scene take seconds to plan; SIGTERM once the
+    // first scenes are written ends it within 5 s with status 130, an error naming the
+    // planning, and no plan.json (the plan is written only whole).
+    let dir = scratch("hardening/sigterm_plan");
+    std::fs::write(dir.join("scene.json"), column_scene().to_string()).unwrap();
+    let axis = |name: &str| json!({"name": name, "field": "/time/duration", "values": (0..100).map(|k| json!(0.001 * (k + 1) as f64)).collect::<Vec<_>>()});
+    let axis2 = json!({"name": "b", "field": "/output/history_stride", "values": (1..=100).collect::<Vec<_>>()});
+    let study = json!({"scene": "scene.json", "out": "out", "axes": [axis("a"), axis2]});
+    let p = dir.join("study.json");
+    std::fs::write(&p, study.to_string()).unwrap();
+    let scenes = dir.join("out/scenes");
+    let (status, err, _) = sigterm_when(&["study", "plan", p.to_str().unwrap()], 30.0, || std::fs::read_dir(&scenes).map(|d| d.count() > 10).unwrap_or(false));
+    assert_eq!(status.code(), Some(jointquake::interrupt::EXIT_STATUS), "{err}");
+    assert_mentions(&err, &["interrupted", "planning of the study"]);
+    assert!(!dir.join("out/plan.json").exists());
+    let written = std::fs::read_dir(&scenes).unwrap().count();
+    assert!(written < 10_000, "every scene planned before the signal was honoured");
+}
+
+/// The column scene with a reservoir on its four sides at `level` (z of the column: 0 to its top).
+fn column_with_pool(level: f64) -> Value {
+    let mut sc = column_scene();
+    sc["loads"] = json!({"gravity": {}});
+    sc["reservoir"] = json!({"faces": ["bc:sides"], "level": level});
+    sc
+}
+
+#[test]
+fn pool_level_below_every_wet_face_is_refused() {
+    // Issue 34: a pool level below every wet face gave no warning: the reservoir added no
+    // pressure and no mass, silently. Decided: an error (that reservoir touches nothing), naming
+    // the field, the lowest wet node and the fix.
+    let e = run_error("pool_below", &column_with_pool(-5.0));
+    assert_mentions(&e, &["reservoir.level = -5 m", "at or below every wet node", "remove the reservoir section"]);
+}
+
+#[test]
+fn pool_level_far_above_the_crest_warns() {
+    // Issue 34: a pool level far above the crest gave no warning. Now above the highest wet
+    // node by more than POOL_ABOVE_CREST_WARN_FRACTION (10 %) of the wet height: a warning in
+    // summary.json (overtopping is not modelled); a level inside the wet height: none.
+    let (p, dir) = write_scene("pool_above", &column_with_pool(1000.0));
+    let s = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap();
+    let w = s.warnings.iter().find(|w| w.contains("reservoir.level = 1000 m")).unwrap_or_else(|| panic!("no pool warning in {:?}", s.warnings));
+    assert_mentions(w, &["above the highest wet node", "overtopping is not modelled"]);
+    let (p, dir) = write_scene("pool_inside", &column_with_pool(3.0));
+    let s = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap();
+    assert!(!s.warnings.iter().any(|w| w.contains("reservoir")), "{:?}", s.warnings);
+}
+
+#[test]
+fn full_disk_leaves_no_history_cut_mid_row_and_no_vtu_tmp_at_several_sizes() {
+    // Issue 34: on a full disk, in 3 of 10 sizes a history CSV ended mid-row and `.vtu.tmp`
+    // files were left. A full disk is simulated per process (unprivileged: no small tmpfs) by a
+    // file-size limit, setrlimit(RLIMIT_FSIZE) with SIGXFSZ ignored, in the child run: a write
+    // beyond it fails part-way with EFBIG as it would with ENOSPC. At each of 10 limits from
+    // 300 B to 400 kB the run of the boxes scene (frames every step, monitor and joint
+    // histories) either finishes or fails with an error; either way every CSV it leaves ends
+    // with a whole line and no `*.tmp` is left anywhere under --out.
+    use std::os::unix::process::CommandExt;
+    let dir = scratch("hardening/full_disk");
+    let mut sc = boxes_scene();
+    sc["time"]["duration"] = json!(0.002);
+    sc["output"]["monitor"] = json!([{"name": "top", "point": [0.5, 0.5, 2.0]}]);
+    sc["output"]["history_stride"] = json!(1);
+    sc["output"]["joint_forces"] = json!(true);
+    let p = dir.join("scene.json");
+    std::fs::write(&p, sc.to_string()).unwrap();
+    let mut failed = 0;
+    // the run's files: VTU frames about 6–10 kB, histories 1–20 kB; 9 limits where some file
+    // hits the limit part-way (measured: every limit up to 6 kB ends the run), and 400 kB, where
+    // the run finishes (the control)
+    let mut finished_at_400k = false;
+    for limit in [300u64, 700, 1_000, 1_500, 2_200, 3_000, 4_000, 5_000, 6_000, 400_000] {
+        let out = dir.join(format!("out-{limit}"));
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_jointquake"));
+        c.args(["run", p.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()]);
+        // SAFETY: setrlimit and signal are async-signal-safe and touch no memory of the parent.
+        unsafe {
+            c.pre_exec(move || {
+                let r = libc::rlimit { rlim_cur: limit, rlim_max: limit };
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &r) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+        let o = c.output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        if !o.status.success() {
+            failed += 1;
+            assert!(err.contains("error:") && !err.contains("panicked"), "limit {limit}: {err}");
+        } else if limit == 400_000 {
+            finished_at_400k = true;
+        }
+        for f in files_under(&out) {
+            let name = f.file_name().unwrap().to_string_lossy().into_owned();
+            assert!(!name.ends_with(".tmp") && !name.contains(".tmp."), "limit {limit}: {} left", f.display());
+            if name.ends_with(".csv") {
+                let text = std::fs::read(&f).unwrap();
+                assert!(text.is_empty() || text.ends_with(b"\n"), "limit {limit}: {} ends mid-row", f.display());
+            }
+        }
+    }
+    assert!(failed >= 8, "only {failed} of 10 limits were reached: the sizes test little");
+    assert!(finished_at_400k, "the control run under 400 kB per file did not finish");
+}
+
+#[test]
+fn cli_numeric_options_out_of_range_are_refused_naming_the_option() {
+    // Issue 33 §1 and 34: every numeric option of `record`, `testcase`, `study`, `modes`,
+    // `wedge-fs` and `run` is checked (finite, in the range docs/cli.md states) before anything
+    // is read or written: `record info --g -9.81` was accepted, NaN/inf options became the
+    // defaults. Each line: the command, then the option the error must name.
+    let dir = scratch("hardening/cli_bounds");
+    let rec = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/records/elcentro1940_NS_chopra.txt");
+    let r = rec.to_str().unwrap();
+    let o = dir.join("o").to_str().unwrap().to_string();
+    let (sp, _) = write_scene("cli_bounds_scene", &column_scene());
+    let sc = sp.to_str().unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["record", "info", r, "--g=-9.81", "--out", &o], "--g = -9.81"),
+        (vec!["record", "info", r, "--g", "NaN", "--out", &o], "--g = NaN"),
+        (vec!["record", "correct", r, "--out", &o, "--g", "inf"], "--g = inf"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "1e308", "--out", &o], "--pga = 1e308"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--tg=-1", "--out", &o], "--tg = -1"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--beta-max", "NaN", "--out", &o], "--beta-max = NaN"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--max-iterations", "1000000000", "--out", &o], "--max-iterations"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--tolerance", "NaN", "--out", &o], "--tolerance = NaN"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--band", "0.1,inf", "--out", &o], "--band = inf"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--duration", "1e9", "--out", &o], "duration"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--dt", "1e-300", "--out", &o], "dt"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--components", "7", "--out", &o], "components"),
+        (vec!["record", "synth", "--structure", "arch", "--site", "I", "--pga", "0.3", "--rise", "NaN", "--out", &o], "rise"),
+        (vec!["record", "match", r, "--structure", "arch", "--site", "I", "--pga", "NaN", "--out", &o], "--pga = NaN"),
+        (vec!["record", "match", r, "--structure", "arch", "--site", "I", "--pga", "0.3", "--out", &o, "--g", "0"], "--g = 0"),
+        (vec!["modes", sc, "--count", "0"], "--count = 0"),
+        // wedge-fs: checked by the wedge's own input check (rigid::wedge), one rule for the
+        // option and the input file
+        (vec!["wedge-fs", "--H=-5"], "wedge height H [m] = -5"),
+        (vec!["wedge-fs", "--crack", "70/165", "--crack-distance", "NaN"], "tension crack distance L behind the crest [m]"),
+        (vec!["testcase", "patch", "--mu", "NaN", "--out", &o], "mu"),
+        (vec!["run", sc, "--duration", "NaN", "--out", &o], "--duration NaN"),
+        (vec!["run", sc, "--threads", "0", "--out", &o], "threads"),
+    ];
+    for (args, option) in cases {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_jointquake")).args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?} was accepted");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(err.contains(option), "{args:?}: the error does not name {option}: {err}");
+    }
+}
+
+/// The incline of pipelines/incline.json (30° slope, the committed hex fixture) with no base
+/// record, μ = 0.3 and `on_exit: "report"` on Layer1: the slider slides under gravity alone
+/// (tan 30° > 0.3), its slave nodes leave their candidate sets and, carrying no force, sink
+/// into the base (issue 34: 3.73 m with exit 0). Soft (E = 1e8 Pa) for a larger step.
+fn incline_sinking_scene(allow: bool) -> Value {
+    let mut s: Value = serde_json::from_str(&std::fs::read_to_string(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("pipelines/incline.json")).unwrap()).unwrap();
+    s["geometry"]["msh"] = json!(fixture("incline_hex.msh"));
+    s["materials"][0]["E"] = json!(1e8);
+    s["materials"][1]["E"] = json!(1e8);
+    s["joints"] = json!([{"name": "J", "master": "joint:J:base", "slave": "joint:J:slider", "mu": 0.3, "layer": 1, "on_exit": "report"}]);
+    s["loads"] = json!({"gravity": {}});
+    s["damping"] = json!({});
+    s["equilibrium"] = json!({"method": "none"});
+    s["time"] = json!({"duration": 1.0, "courant": 0.9});
+    s["output"] = json!({"frames": false, "allow_penetration": allow});
+    s
+}
+
+#[test]
+fn incline_block_sinking_into_its_base_does_not_end_with_exit_0() {
+    // Issue 34: `on_exit: "report"` let the incline block sink 3.73 m into its base with exit
+    // 0 and a summary "max penetration 6.6e-24 m". Now lost nodes are measured against the
+    // master surface they left, and a largest penetration above PENETRATION_WARN_FRACTION
+    // (10 %) of the slave face size ends the run with an error after its outputs and summary
+    // are written, unless the scene sets output.allow_penetration (then exit 0 and the warning).
+    let (p, dir) = write_scene("incline_sinks", &incline_sinking_scene(false));
+    let out = dir.join("out");
+    let e = run(&p, &RunOptions { out_dir: Some(out.clone()), ..Default::default() }).unwrap_err().to_string();
+    assert_mentions(&e, &["joint J", "largest penetration", "% of the slave face size", "output.allow_penetration"]);
+    let s = jointquake::output::summary::RunSummary::read(&out).unwrap();
+    let j = &s.joints[0];
+    assert!(j.max_penetration > jointquake::output::recorder::PENETRATION_WARN_FRACTION * j.face_size, "penetration {} of face {}", j.max_penetration, j.face_size);
+    assert!(s.warnings.iter().any(|w| w.contains("largest penetration")), "{:?}", s.warnings);
+    // the scene's opt-out: the same run ends Ok, with the warning
+    let (p, dir) = write_scene("incline_sinks_allowed", &incline_sinking_scene(true));
+    let s = run(&p, &RunOptions { out_dir: Some(dir.join("out")), ..Default::default() }).unwrap();
+    assert!(s.warnings.iter().any(|w| w.contains("largest penetration")), "{:?}", s.warnings);
 }

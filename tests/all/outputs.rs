@@ -713,7 +713,9 @@ fn sliding_off_scene(on_exit: &str, duration: f64) -> Value {
         "loads": {"gravity": {"direction": [1, 0, -1]}},
         "equilibrium": {"method": "none"},
         "time": {"duration": duration},
-        "output": {"frame_interval": 0.1}
+        // the block sinks where "report" loses its nodes: the run is about the warnings, so it
+        // accepts the penetration that would otherwise end it with an error (issue 34)
+        "output": {"frame_interval": 0.1, "allow_penetration": true}
     })
 }
 

@@ -359,7 +359,44 @@ pub fn wet_faces_of_scene(mesh: &Mesh, scene: &crate::scene::Scene, r: &crate::s
         faces.extend(wet_faces(mesh, g, &volume)?);
     }
     let spec = reservoir_spec(mesh, r, &faces, scene);
+    let (zmin, _) = wet_height_range(mesh, &faces);
+    if !faces.is_empty() && spec.level <= zmin {
+        return Err(ModelError::Invalid(format!(
+            "reservoir.level = {} m is at or below every wet node of reservoir.faces (the lowest is at z = {zmin:.3} m): the water touches no wet face, so the reservoir would add no pressure and no mass. Raise the level, or remove the reservoir section for an empty reservoir",
+            spec.level
+        ))
+        .into());
+    }
     Ok((faces, spec))
+}
+
+/// The lowest and highest z of the wet faces' nodes [m] (+∞, −∞ without faces).
+fn wet_height_range(mesh: &Mesh, faces: &[WetFace]) -> (f64, f64) {
+    faces.iter().flat_map(|f| f.nodes.iter()).map(|&v| mesh.nodes[v][2]).fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| (lo.min(z), hi.max(z)))
+}
+
+/// A pool level above the highest wet node (the crest, for a dam's upstream face) by more than
+/// this fraction of the wet faces' height span gets a warning: 0.1. Overtopping is not
+/// modelled (no pressure on the crest, no water beyond the wet faces); a level a little above
+/// the top node is a flood level worth running, a tenth of the dam's height above it is most
+/// likely a wrong datum or unit.
+pub const POOL_ABOVE_CREST_WARN_FRACTION: f64 = 0.1;
+
+/// The warning for a pool level far above the wet faces ([`POOL_ABOVE_CREST_WARN_FRACTION`]);
+/// `None` otherwise. (A level at or below every wet node is an error of
+/// [`wet_faces_of_scene`]: that reservoir touches nothing.)
+pub fn pool_level_warning(mesh: &Mesh, faces: &[WetFace], spec: &ReservoirSpec) -> Option<String> {
+    let (zmin, zmax) = wet_height_range(mesh, faces);
+    let span = zmax - zmin;
+    (span.is_finite() && spec.level > zmax + POOL_ABOVE_CREST_WARN_FRACTION * span).then(|| {
+        format!(
+            "reservoir.level = {} m is {:.3} m above the highest wet node (z = {zmax:.3} m; more than {:.0} % of the wet faces' height {span:.3} m): overtopping is not modelled (no pressure above the wet faces), and the added mass takes the depth H = {:.3} m. Check the level's datum",
+            spec.level,
+            spec.level - zmax,
+            100.0 * POOL_ABOVE_CREST_WARN_FRACTION,
+            spec.depth()
+        )
+    })
 }
 
 #[cfg(test)]
