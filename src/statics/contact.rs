@@ -18,7 +18,8 @@
 //! Conventions (written once, here): w = Σ_I N_I Δu_I − Δu_s is the master point's motion
 //! relative to the slave node over the increment, with N_I the weights of the pair's master
 //! point (`bonded::master_point` for node-to-segment joints, the nearest master node O for
-//! node-to-node); n is the slave normal (towards the master), so the gap is g = n · w (the
+//! node-to-node, the mortar weights c_k = M_jk / D_jj of the initial configuration for dual
+//! mortar, whose pair then has the area D_jj); n is the slave normal (towards the master), so the gap is g = n · w (the
 //! increment starts from a grouted joint: gap 0 with no force), w_t = w − g n, and the normal
 //! force is r_n = −k g (compressive positive). q is the force on the slave node (−N_I q on the
 //! masters). Forces in N, displacements in m.
@@ -363,6 +364,21 @@ impl TangentSolver {
 /// penalty `penalty_factor` × the slave node's diagonal stiffness ([`PENALTY_FACTOR`]). Returns
 /// Δu over every model dof and the report, and writes each pair's state, forces and gap into
 /// `contact`.
+/// Dual mortar joint `ji`: each slave node's mortar master point (model nodes, weights
+/// c_k = M_jk / D_jj) and its area D_jj on the initial configuration
+/// (`ContactSolver::mortar_master_points`; `None` below the mortar cover); empty for the other
+/// methods.
+#[allow(clippy::type_complexity)]
+fn mortar_points(problem: &Problem, contact: &ContactState, ji: usize) -> Result<Vec<Option<(Vec<(usize, f64)>, f64)>>, Error> {
+    let (model, j) = (&problem.model, &problem.joints[ji]);
+    if j.method != Method::Mortar {
+        return Ok(Vec::new());
+    }
+    let zero = vec![0.0; 3 * model.n_nodes()];
+    let points = crate::contact::force::ContactSolver::new(model, &problem.joints).mortar_master_points(model, ji, &contact.joints[ji], &zero);
+    Ok(points.map_err(|e| ModelError::Invalid(format!("static contact, joint \"{}\": {e}", j.tag.name)))?)
+}
+
 pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64) -> Result<(Vec<f64>, StaticContactInfo), Error> {
     let model = &problem.model;
     let k_full = stiffness(model, &vec![true; model.materials.len()]);
@@ -378,21 +394,24 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
         if j.law.tied {
             continue;
         }
+        let mut mortar = mortar_points(problem, contact, ji)?;
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
             if unformed[ji][i] {
                 // the slave of a tied joint is the slave of no other joint (the rule: `unformed_pairs`)
                 info.on_tied += 1;
                 continue;
             }
-            let masters = match j.method {
-                Method::Ntn => vec![(j.tag.nearest_master_node(i), 1.0)],
+            let found = match j.method {
+                Method::Ntn => Some((vec![(j.tag.nearest_master_node(i), 1.0)], j.tag.areas[i])),
+                Method::Mortar => mortar[i].take(),
                 _ => match master_point(model, j, i)? {
-                    (_, MasterHit::NearestNode) => {
-                        info.left_out += 1;
-                        continue;
-                    }
-                    (m, _) => m,
+                    (_, MasterHit::NearestNode) => None,
+                    (m, _) => Some((m, j.tag.areas[i])),
                 },
+            };
+            let Some((masters, area)) = found else {
+                info.left_out += 1;
+                continue;
             };
             let mut w: [Vec<(usize, f64)>; 3] = Default::default();
             for (c, wc) in w.iter_mut().enumerate() {
@@ -411,7 +430,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
                 wc.retain(|e| e.1 != 0.0);
             }
             let diag = (0..3).map(|c| k_full.get(3 * s + c, 3 * s + c)).sum::<f64>() / 3.0;
-            pairs.push(Pair { joint: ji, index: i, w, n: j.frames[i][0], k: penalty_factor * diag, area: j.tag.areas[i], closed: true, changes: 0 });
+            pairs.push(Pair { joint: ji, index: i, w, n: j.frames[i][0], k: penalty_factor * diag, area, closed: true, changes: 0 });
         }
     }
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
