@@ -175,7 +175,7 @@ struct TestcaseArgs {
     #[arg(long)]
     #[serde(skip_serializing_if = "Option::is_none")]
     slave: Option<String>,
-    /// Contact method: nts, ntn or penalty.
+    /// Contact method: nts, ntn, penalty or mortar.
     #[arg(long)]
     #[serde(skip_serializing_if = "Option::is_none")]
     method: Option<String>,

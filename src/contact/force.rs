@@ -40,7 +40,7 @@ use super::free_edge;
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force_with_inverse, penalty_force, JointLaw, PairHistory, PairState};
 pub use super::state::{ContactState, JointRecord, PairRecord, SearchEvents};
-use super::mortar::{overlap_integrals, SlaveFace};
+use super::mortar::{overlap_integrals, Overlap, SlaveFace};
 use super::query::{project_along_on_quad_from, project_along_on_tri, select_projection, Location, INSIDE_TOL_DEFAULT};
 use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
@@ -84,6 +84,47 @@ const MORTAR_MASTERS: usize = MORTAR_NODES - 1;
 /// (`SearchEvents::lost`), as an NTS node off the master is.
 const MORTAR_MIN_COVER: f64 = 0.25;
 
+/// A slave node's master entries: master-local nodes, `M_jk` [m²], and the count used.
+type MortarRow = ([u32; MORTAR_MASTERS], [f64; MORTAR_MASTERS], u8);
+
+/// A slave face's mortar integrals are re-evaluated when one of its nodes has moved, relative to
+/// its centre master node and tangentially (along the joint), by more than this fraction of the
+/// face size (√ of its projected area) since the face's last evaluation, or when a node's centre
+/// (hence the face's candidate set) has changed: 0.05. Between evaluations the weights
+/// `M_jk / D_jj` are those of positions up to 0.05 h of sliding back: the master point lags the
+/// exact mortar projection by at most that along the surface (no error on a flat joint, where
+/// the gap and the relative slip of a weighted point of the master plane do not depend on the
+/// weights; a gap error of order (0.05 h)² / R on a joint of radius R). Momentum is kept exactly
+/// (the weights always sum to one). A joint that does not slide (a tie, a stuck joint, the
+/// static stages) keeps the integrals of its first step: the stick then holds material points,
+/// where weights re-evaluated on each step's prediction drift with the prediction's relative
+/// motion (docs/contact.md, "Dual mortar").
+const MORTAR_REEVALUATE: f64 = 0.05;
+
+/// One slave face's share of the mortar integrals, kept between steps.
+#[derive(Clone, Debug, Default)]
+struct FaceIntegrals {
+    /// False until the face is first evaluated.
+    evaluated: bool,
+    /// Per face node, at the evaluation: its centre (master-local node) and its displacement
+    /// relative to that centre's [m].
+    centre: [u32; 4],
+    rel: [Vector3<f64>; 4],
+    /// √ of the projected face area at the evaluation [m].
+    size: f64,
+    /// The overlapping master faces and their integrals.
+    overlaps: Vec<(u32, Overlap)>,
+}
+
+/// The mortar integrals of one joint: per slave face ([`FaceIntegrals`]) and summed per slave
+/// node (`d` = `D_jj` [m²], `rows` its master entries).
+#[derive(Default)]
+struct MortarJoint {
+    faces: Vec<FaceIntegrals>,
+    d: Vec<f64>,
+    rows: Vec<MortarRow>,
+}
+
 /// The mortar pairs of the current step and the scratch of their integrals, apart from the
 /// node-to-segment pairs because a mortar slave node has more master nodes than a face's four.
 #[derive(Default)]
@@ -94,12 +135,14 @@ struct MortarScratch {
     /// evaluation.
     order: Vec<u32>,
     evaluated_at: Vec<u32>,
-    /// Per slave node of the joint being searched: `D_jj` [m²] and its master entries
-    /// (master-local node, `M_jk` [m²]; `count` used).
-    d: Vec<f64>,
-    rows: Vec<([u32; MORTAR_MASTERS], [f64; MORTAR_MASTERS], u8)>,
+    /// Per joint (empty for the other methods' joints), its integrals.
+    joints: Vec<MortarJoint>,
+    /// Slave nodes whose faces were re-evaluated this step (local indices).
+    touched: Vec<u32>,
     /// Candidate master faces of one slave face.
     cand: Vec<u32>,
+    /// Slave faces evaluated so far (all joints): the cost counter of the caching.
+    face_evaluations: u64,
 }
 
 /// Slave node `i` found no master face this step: counted lost, force-free.
@@ -356,6 +399,12 @@ impl<'m> ContactSolver<'m> {
         let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
         ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+    }
+
+    /// Slave faces whose mortar integrals were evaluated so far, all mortar joints together (the
+    /// cost counter of their caching, [`MORTAR_REEVALUATE`]).
+    pub fn mortar_face_evaluations(&self) -> u64 {
+        self.mortar.face_evaluations
     }
 
     /// Whether `node` is partly fixed (and moves on its free components only).
@@ -776,21 +825,24 @@ impl ContactSolver<'_> {
 
     /// The mortar pairs of joint `j` (`Method::Mortar`) on the prediction `u_next`
     /// (docs/contact.md, "Dual mortar"): the mortar integrals of every slave face with the master
-    /// faces of its candidate set (Layer2 around the centres of its nodes), evaluated every step
-    /// on the predicted positions, so that the overlaps follow the faces as they slide; summed per
-    /// slave node into `D_jj` and `M_jk`; then one pair per slave node whose master is
-    /// `Σ_k (M_jk / D_jj) x_k`, forced as a node-to-segment pair is. Each node's centre follows
-    /// the master node of its largest weight.
+    /// faces of its candidate set (Layer2 around the centres of its nodes), on the predicted
+    /// positions, re-evaluated for the faces that slid or changed candidates
+    /// ([`MORTAR_REEVALUATE`]); summed per slave node into `D_jj` and `M_jk`; then one pair per
+    /// slave node whose master is `Σ_k (M_jk / D_jj) x_k`, forced as a node-to-segment pair is.
+    /// Each node's centre follows the master node of its largest weight.
     #[allow(clippy::too_many_arguments)]
     fn mortar_search_into(&mut self, model: &Model, j: &ContactJoint, ji: usize, rec: &mut JointRecord, dt2: f64, u: &[f64], u_next: &[f64]) -> Result<(), StepError> {
         let n_s = j.tag.n_slave();
-        let mut d = std::mem::take(&mut self.mortar.d);
-        let mut rows = std::mem::take(&mut self.mortar.rows);
-        d.clear();
-        d.resize(n_s, 0.0);
-        rows.clear();
-        rows.resize(n_s, ([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0));
-        let overflow = self.mortar_integrals_into(model, j, rec, u_next, &mut d, &mut rows);
+        if self.mortar.joints.len() <= ji {
+            self.mortar.joints.resize_with(ji + 1, MortarJoint::default);
+        }
+        let mut mj = std::mem::take(&mut self.mortar.joints[ji]);
+        if mj.faces.len() != j.tag.slave.faces.len() || mj.d.len() != n_s {
+            mj.faces = vec![FaceIntegrals::default(); j.tag.slave.faces.len()];
+            mj.d = vec![0.0; n_s];
+            mj.rows = vec![([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0); n_s];
+        }
+        let overflow = self.mortar_integrals_into(model, j, rec, u_next, &mut mj);
         if let Some(i) = overflow {
             return Err(StepError::Contact(format!(
                 "joint \"{}\" (mortar): slave node {} couples to more than {MORTAR_MASTERS} master nodes: the slave side is far coarser than the master. Make the finer side the slave (`auto`, or swap `master` and `slave`) or refine the slave side",
@@ -804,8 +856,9 @@ impl ContactSolver<'_> {
                 unform_pair(rec, i);
                 continue;
             }
-            let (ml, mv, cnt) = rows[i];
-            if !(d[i] >= MORTAR_MIN_COVER * j.tag.areas[i]) {
+            let (ml, mv, cnt) = mj.rows[i];
+            let di = mj.d[i];
+            if !(di >= MORTAR_MIN_COVER * j.tag.areas[i]) {
                 lose_pair(rec, i);
                 continue;
             }
@@ -813,7 +866,7 @@ impl ContactSolver<'_> {
             let mut best = (f64::MIN, 0u32);
             for k in 0..cnt as usize {
                 pm.nodes[k] = ms.nodes[ml[k] as usize] as u32;
-                pm.weights[k] = mv[k] / d[i];
+                pm.weights[k] = mv[k] / di;
                 if pm.weights[k] > best.0 {
                     best = (pm.weights[k], ml[k]);
                 }
@@ -826,30 +879,110 @@ impl ContactSolver<'_> {
             pm.face = ms.faces_of_node(best.1 as usize).first().map_or(-1, |&f| f as i32);
             let s = j.tag.slave_nodes()[i];
             let Some(mobility) = self.pair_mobility::<MORTAR_MASTERS, MORTAR_NODES>(model, s, &j.frames[i][0], &pm) else { continue };
-            let (a, matrix) = self.active_pair(model, j, ji, &rec.pairs[i], i, &pm, &mobility, dt2, u, d[i]);
+            let (a, matrix) = self.active_pair(model, j, ji, &rec.pairs[i], i, &pm, &mobility, dt2, u, di);
             self.mortar.active.push(a);
             self.mortar.mob_matrix.extend(matrix);
             rec.pairs[i].face = pm.face;
         }
-        self.mortar.d = d;
-        self.mortar.rows = rows;
+        self.mortar.joints[ji] = mj;
         Ok(())
     }
 
-    /// The mortar integrals of joint `j` at the positions `u_next`, summed per slave node: `d[i]`
-    /// = `D_jj` and `rows[i]` its master-local nodes with `M_jk` [m²]. Returns a slave node with
-    /// more than `MORTAR_MASTERS` master nodes, if any.
-    fn mortar_integrals_into(&mut self, model: &Model, j: &ContactJoint, rec: &JointRecord, u_next: &[f64], d: &mut [f64], rows: &mut [([u32; MORTAR_MASTERS], [f64; MORTAR_MASTERS], u8)]) -> Option<usize> {
+    /// The mortar master point of every slave node of mortar joint `ji` at the displacements
+    /// `u`: its master nodes (model indices) with their weights `c_k = M_jk / D_jj`, and `D_jj`
+    /// [m²], from integrals evaluated afresh at `u` (the candidate sets around the centres of
+    /// `rec`); `None` for a node below the cover of a pair ([`MORTAR_MIN_COVER`]). What the
+    /// static stages pair a mortar joint's slave node with (`statics::contact`, and grouting
+    /// through [`Self::mortar_gaps`]).
+    #[allow(clippy::type_complexity)]
+    pub fn mortar_master_points(&mut self, model: &Model, ji: usize, rec: &JointRecord, u: &[f64]) -> Result<Vec<Option<(Vec<(usize, f64)>, f64)>>, StepError> {
+        let j = &self.joints[ji];
+        let n_s = j.tag.n_slave();
+        let mut mj = MortarJoint { faces: vec![FaceIntegrals::default(); j.tag.slave.faces.len()], d: vec![0.0; n_s], rows: vec![([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0); n_s] };
+        if let Some(i) = self.mortar_integrals_into(model, j, rec, u, &mut mj) {
+            return Err(StepError::Contact(format!("joint \"{}\" (mortar): slave node {} couples to more than {MORTAR_MASTERS} master nodes: make the finer side the slave", j.tag.name, j.tag.slave_nodes()[i])));
+        }
+        Ok((0..n_s)
+            .map(|i| {
+                let (ml, mv, cnt) = mj.rows[i];
+                let di = mj.d[i];
+                (di >= MORTAR_MIN_COVER * j.tag.areas[i]).then(|| ((0..cnt as usize).map(|k| (j.tag.master.nodes[ml[k] as usize], mv[k] / di)).collect(), di))
+            })
+            .collect())
+    }
+
+    /// The weighted gap of every slave node of mortar joint `ji` at the displacements `u` [m]:
+    /// `n_j · (Σ_k c_k x_k − x_j)` with the master points of [`Self::mortar_master_points`], the
+    /// gap offset not subtracted; `None` below the cover. What grouting a mortar joint closes
+    /// (`statics::sequence::grout_pairs`): the gap the mortar pairs measure.
+    pub fn mortar_gaps(&mut self, model: &Model, ji: usize, rec: &JointRecord, u: &[f64]) -> Result<Vec<Option<f64>>, StepError> {
+        let points = self.mortar_master_points(model, ji, rec, u)?;
+        let j = &self.joints[ji];
+        Ok(points
+            .into_iter()
+            .enumerate()
+            .map(|(i, p)| {
+                p.map(|(masters, _)| {
+                    let xbar = masters.iter().fold(-pos(model, u, j.tag.slave_nodes()[i]), |x, &(m, c)| x + pos(model, u, m) * c);
+                    j.frames[i][0].dot(&xbar)
+                })
+            })
+            .collect())
+    }
+
+    /// Whether slave face `f` of joint `j` must be re-evaluated at `u_next`: never evaluated, a
+    /// node's centre changed, or a node slid relative to its centre by more than
+    /// [`MORTAR_REEVALUATE`] of the face size since the evaluation.
+    fn mortar_face_stale(j: &ContactJoint, rec: &JointRecord, fi: &FaceIntegrals, f: usize, u_next: &[f64]) -> bool {
+        if !fi.evaluated {
+            return true;
+        }
+        let limit2 = (MORTAR_REEVALUATE * fi.size).powi(2);
+        j.tag.slave.faces[f].local_nodes().iter().enumerate().any(|(a, &l)| {
+            let c = rec.pairs[l as usize].center;
+            if c != fi.centre[a] {
+                return true;
+            }
+            let dr = disp(u_next, j.tag.slave_nodes()[l as usize]) - disp(u_next, j.tag.master.nodes[c as usize]) - fi.rel[a];
+            let n = j.frames[l as usize][0];
+            (dr - n * n.dot(&dr)).norm_squared() > limit2
+        })
+    }
+
+    /// Bring the mortar integrals of joint `j` up to date at the positions `u_next`: the stale
+    /// faces ([`Self::mortar_face_stale`]) re-evaluated, then `D_jj` and the rows of their
+    /// nodes summed again from the faces around them (in the order of the faces and of their
+    /// candidates, so the sums do not depend on when each face was evaluated). Returns a slave
+    /// node with more than `MORTAR_MASTERS` master nodes, if any.
+    fn mortar_integrals_into(&mut self, model: &Model, j: &ContactJoint, rec: &JointRecord, u_next: &[f64], mj: &mut MortarJoint) -> Option<usize> {
         let mut cand = std::mem::take(&mut self.mortar.cand);
-        let mut overflow = None;
+        let mut touched = std::mem::take(&mut self.mortar.touched);
+        touched.clear();
         let (sl, ms) = (&j.tag.slave, &j.tag.master);
-        for face in &sl.faces {
+        for (f, face) in sl.faces.iter().enumerate() {
+            if !Self::mortar_face_stale(j, rec, &mj.faces[f], f, u_next) {
+                continue;
+            }
+            self.mortar.face_evaluations += 1;
+            let fi = &mut mj.faces[f];
+            fi.overlaps.clear();
+            fi.evaluated = true;
+            for (a, &l) in face.local_nodes().iter().enumerate() {
+                let c = rec.pairs[l as usize].center;
+                fi.centre[a] = c;
+                fi.rel[a] = disp(u_next, sl.nodes[l as usize]) - disp(u_next, ms.nodes[c as usize]);
+            }
+            touched.extend_from_slice(face.local_nodes());
             let nodes = face.nodes();
             let mut x = [Vector3::zeros(); 4];
             for (a, &nd) in nodes.iter().enumerate() {
                 x[a] = pos(model, u_next, nd as usize);
             }
-            let Some(sf) = SlaveFace::new(&x[..nodes.len()]) else { continue };
+            let Some(sf) = SlaveFace::new(&x[..nodes.len()]) else {
+                fi.size = 0.0;
+                continue;
+            };
+            fi.size = sf.plane_area.sqrt();
             cand.clear();
             for &l in face.local_nodes() {
                 self.candidates_into(j, rec.pairs[l as usize].center, 2);
@@ -859,12 +992,22 @@ impl ContactSolver<'_> {
             cand.dedup();
             for &mf in &cand {
                 let (xm, km) = face_positions(model, j, mf as usize, u_next);
-                let Some(o) = overlap_integrals(&sf, &xm[..km]) else { continue };
-                for (a, &l) in face.local_nodes().iter().enumerate() {
-                    let l = l as usize;
-                    d[l] += o.d[a];
-                    let row = &mut rows[l];
-                    for (b, &ml) in ms.faces[mf as usize].local_nodes().iter().enumerate() {
+                if let Some(o) = overlap_integrals(&sf, &xm[..km]) {
+                    fi.overlaps.push((mf, o));
+                }
+            }
+        }
+        touched.sort_unstable();
+        touched.dedup();
+        let mut overflow = None;
+        for &l in &touched {
+            let l = l as usize;
+            let (mut dl, mut row): (f64, MortarRow) = (0.0, ([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0));
+            for &g in sl.faces_of_node(l) {
+                let Some(a) = sl.faces[g as usize].local_nodes().iter().position(|&x| x as usize == l) else { continue };
+                for (mf, o) in &mj.faces[g as usize].overlaps {
+                    dl += o.d[a];
+                    for (b, &ml) in ms.faces[*mf as usize].local_nodes().iter().enumerate() {
                         let cnt = row.2 as usize;
                         match row.0[..cnt].iter().position(|&x| x == ml) {
                             Some(p) => row.1[p] += o.m[a][b],
@@ -878,8 +1021,11 @@ impl ContactSolver<'_> {
                     }
                 }
             }
+            mj.d[l] = dl;
+            mj.rows[l] = row;
         }
         self.mortar.cand = cand;
+        self.mortar.touched = touched;
         overflow
     }
 

@@ -18,7 +18,8 @@
 //! Conventions (written once, here): w = Σ_I N_I Δu_I − Δu_s is the master point's motion
 //! relative to the slave node over the increment, with N_I the weights of the pair's master
 //! point (`bonded::master_point` for node-to-segment joints, the nearest master node O for
-//! node-to-node); n is the slave normal (towards the master), so the gap is g = n · w (the
+//! node-to-node, the mortar weights c_k = M_jk / D_jj of the initial configuration for dual
+//! mortar, whose pair then has the area D_jj); n is the slave normal (towards the master), so the gap is g = n · w (the
 //! increment starts from a grouted joint: gap 0 with no force), w_t = w − g n, and the normal
 //! force is r_n = −k g (compressive positive). q is the force on the slave node (−N_I q on the
 //! masters). Forces in N, displacements in m.
@@ -363,6 +364,21 @@ impl TangentSolver {
 /// penalty `penalty_factor` × the slave node's diagonal stiffness ([`PENALTY_FACTOR`]). Returns
 /// Δu over every model dof and the report, and writes each pair's state, forces and gap into
 /// `contact`.
+/// Dual mortar joint `ji`: each slave node's mortar master point (model nodes, weights
+/// c_k = M_jk / D_jj) and its area D_jj on the initial configuration
+/// (`ContactSolver::mortar_master_points`; `None` below the mortar cover); empty for the other
+/// methods.
+#[allow(clippy::type_complexity)]
+fn mortar_points(problem: &Problem, contact: &ContactState, ji: usize) -> Result<Vec<Option<(Vec<(usize, f64)>, f64)>>, Error> {
+    let (model, j) = (&problem.model, &problem.joints[ji]);
+    if j.method != Method::Mortar {
+        return Ok(Vec::new());
+    }
+    let zero = vec![0.0; 3 * model.n_nodes()];
+    let points = crate::contact::force::ContactSolver::new(model, &problem.joints).mortar_master_points(model, ji, &contact.joints[ji], &zero);
+    Ok(points.map_err(|e| ModelError::Invalid(format!("static contact, joint \"{}\": {e}", j.tag.name)))?)
+}
+
 pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64) -> Result<(Vec<f64>, StaticContactInfo), Error> {
     let model = &problem.model;
     let k_full = stiffness(model, &vec![true; model.materials.len()]);
@@ -371,7 +387,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let k0 = t.reduce(&k_full);
     let f0 = t.reduce_vector(f);
     let mut info = StaticContactInfo::default();
-    let mut pairs = active_pairs(problem, &t, &k_full, penalty_factor, &mut info)?;
+    let mut pairs = active_pairs(problem, &t, &k_full, contact, penalty_factor, &mut info)?;
     let residual = Residual { k0: &k0, f0: &f0, joints: &problem.joints, nf: norm(&f0) };
     let uh = newton(&residual, &mut pairs, t.n, &mut info)?;
     // the result and the pairs' records
@@ -384,8 +400,9 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
 
 /// The pairs of the joints that are not tied, with their relative motion over the reduced
 /// unknowns of `t` and their penalty (`penalty_factor` × the slave node's mean diagonal of
-/// `k_full`); counts the pairs on tied nodes and those left out into `info`.
-fn active_pairs(problem: &Problem, t: &Bonding, k_full: &Csc, penalty_factor: f64, info: &mut StaticContactInfo) -> Result<Vec<Pair>, Error> {
+/// `k_full`; a mortar slave node pairs with its mortar master point and area from `contact`);
+/// counts the pairs on tied nodes and those left out into `info`.
+fn active_pairs(problem: &Problem, t: &Bonding, k_full: &Csc, contact: &ContactState, penalty_factor: f64, info: &mut StaticContactInfo) -> Result<Vec<Pair>, Error> {
     let model = &problem.model;
     let mut pairs = Vec::new();
     let unformed = crate::contact::joint::unformed_pairs(&problem.joints);
@@ -393,25 +410,28 @@ fn active_pairs(problem: &Problem, t: &Bonding, k_full: &Csc, penalty_factor: f6
         if j.law.tied {
             continue;
         }
+        let mut mortar = mortar_points(problem, contact, ji)?;
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
             if unformed[ji][i] {
                 // the slave of a tied joint is the slave of no other joint (the rule: `unformed_pairs`)
                 info.on_tied += 1;
                 continue;
             }
-            let masters = match j.method {
-                Method::Ntn => vec![(j.tag.nearest_master_node(i), 1.0)],
+            let found = match j.method {
+                Method::Ntn => Some((vec![(j.tag.nearest_master_node(i), 1.0)], j.tag.areas[i])),
+                Method::Mortar => mortar[i].take(),
                 _ => match master_point(model, j, i)? {
-                    (_, MasterHit::NearestNode) => {
-                        info.left_out += 1;
-                        continue;
-                    }
-                    (m, _) => m,
+                    (_, MasterHit::NearestNode) => None,
+                    (m, _) => Some((m, j.tag.areas[i])),
                 },
+            };
+            let Some((masters, area)) = found else {
+                info.left_out += 1;
+                continue;
             };
             let w = pair_motion_weights(t, &masters, s);
             let diag = (0..3).map(|c| k_full.get(3 * s + c, 3 * s + c)).sum::<f64>() / 3.0;
-            pairs.push(Pair { joint: ji, index: i, w, n: j.frames[i][0], k: penalty_factor * diag, area: j.tag.areas[i], closed: true, changes: 0 });
+            pairs.push(Pair { joint: ji, index: i, w, n: j.frames[i][0], k: penalty_factor * diag, area, closed: true, changes: 0 });
         }
     }
     Ok(pairs)

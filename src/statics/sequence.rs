@@ -19,7 +19,9 @@
 //!
 //! Grouting: a joint is grouted pair by pair, with the gap its method measures: along the slave
 //! normal to the master face for node-to-segment (a slave node that finds no master face, even
-//! within half a face, keeps offset 0 and is counted), to the master node O for node-to-node
+//! within half a face, keeps offset 0 and is counted), the weighted gap n_j · (Σ_k c_k x_k − x_j)
+//! of the mortar integrals at the grouting state for dual mortar (a node below the mortar
+//! cover keeps offset 0 and is counted), to the master node O for node-to-node
 //! (regression `dam_ntn_static_state_stays_at_rest`: grouted on the faces, the node-to-node
 //! joints started with the chords' gaps to O and the run stopped on its energy check at step
 //! 10).
@@ -118,6 +120,24 @@ pub fn grout_pairs(problem: &Problem, contact: &mut ContactState, u: &[f64], whi
     let model = &problem.model;
     let (mut pairs, mut missed, mut largest) = (0usize, 0usize, 0.0f64);
     for (ji, j) in problem.joints.iter().enumerate() {
+        if j.method == crate::contact::joint::Method::Mortar {
+            // dual mortar: the weighted gap of each slave node (`ContactSolver::mortar_gaps`)
+            let gaps = crate::contact::force::ContactSolver::new(model, &problem.joints).mortar_gaps(model, ji, &contact.joints[ji], u).map_err(|e| ModelError::Invalid(format!("grouting joint \"{}\": {e}", j.tag.name)))?;
+            for (i, g) in gaps.into_iter().enumerate() {
+                if !which(ji, i) {
+                    continue;
+                }
+                match g {
+                    Some(g) => {
+                        contact.joints[ji].pairs[i].gap_offset = g;
+                        largest = largest.max(g.abs());
+                        pairs += 1;
+                    }
+                    None => missed += 1,
+                }
+            }
+            continue;
+        }
         let m = &j.tag.master;
         let pos = |node: usize| Vector3::new(model.mesh.nodes[node][0] + u[3 * node], model.mesh.nodes[node][1] + u[3 * node + 1], model.mesh.nodes[node][2] + u[3 * node + 2]);
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {

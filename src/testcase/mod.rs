@@ -241,7 +241,9 @@ pub struct CaseSpec {
     /// x = 0 and x = 1 m: z = f(x) = sgn R (√(R² − (x − ½)²) − √(R² − ¼)) (R > 0: the lower block
     /// bulges into the upper one; R < 0: a trough). The master side's joint nodes lie on the
     /// cylinder, the slave side's on the master's facets (the initial gap is zero, as CalculiX and
-    /// Abaqus adjust slave nodes); every node column is moved by f(1 − |z|/H). The pressure state
+    /// Abaqus adjust slave nodes; a mortar joint, whose weighted gap sees the two faceted
+    /// surfaces apart, is grouted on this configuration, [`run`]); every node column is moved by
+    /// f(1 − |z|/H). The pressure state
     /// σzz = −p is unchanged (module doc); μ must exceed the steepest slope ½/√(R² − ¼) unless
     /// tied. |R| > 0.5 m; default flat.
     #[serde(default)]

@@ -796,7 +796,7 @@ fn dam_ties_keep_their_meshed_gap_when_released() {
 /// The coarse dam (pipelines/dam_coarse.json, joints with `method`, or `tied` for the
 /// monolithic dam) released at rest from its static state with no record for `duration`
 /// seconds: the crown's drift and the energy balance.
-fn dam_released_at_rest(method: &str, duration: f64) -> jointquake::output::summary::RunSummary {
+pub(crate) fn dam_released_at_rest(method: &str, duration: f64) -> jointquake::output::summary::RunSummary {
     let dir = scratch(&format!("dam-quiet-{method}-{duration}"));
     let mut s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(repo("pipelines/dam_coarse.json")).unwrap()).unwrap();
     if method == "tied" {

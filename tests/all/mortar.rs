@@ -14,21 +14,7 @@ use serde_json::json;
 #[test]
 fn mortar_patch_pressure_passes_on_every_mesh_pair() {
     let mut worst: f64 = 0.0;
-    for (lower, upper, slave) in [
-        ("hex8:3", "hex8:3", "upper"),
-        ("hex8:4", "hex8:3", "lower"),
-        ("hex8:4", "hex8:3", "upper"),
-        ("hex8:7", "hex8:5", "lower"),
-        ("hex8:7", "hex8:5", "upper"),
-        ("tet4:4", "hex8:3", "lower"),
-        ("tet4:4", "hex8:3", "upper"),
-        ("tet4:4", "tet4:3", "lower"),
-        ("tet4:3", "hex8:3", "lower"),
-        ("mixed:4", "hex8:3", "lower"),
-        ("mixed:4", "hex8:3", "upper"),
-        ("hex8:4", "mixed:3", "lower"),
-        ("mixed:4", "mixed:3", "lower"),
-    ] {
+    for (lower, upper, slave) in HEX_TET_PAIRS.into_iter().chain(MIXED_PAIRS) {
         let r = case(json!({"kind": "patch", "lower": lower, "upper": upper, "slave": slave, "method": "mortar"}));
         let (s, p, _) = patch_errors(&r);
         worst = worst.max(s).max(p);
@@ -90,30 +76,50 @@ fn mortar_contact_conserves_momentum() {
     }
 }
 
-/// Pressure and shear (p = 1 MPa, τ = 0.3 MPa < μ p: the joint sticks) on non-conforming pairs
-/// either side slave (measured 1.1e-3, 1.2e-3, 1.4e-3; mixed 4/3 gave 3.2e-2 and is left out). The shear patch is not exact with any
-/// method here: conforming NTS gives 7.2e-4 (hex3-hex3-nts-shear, docs/validation.md §8), the
-/// incremental stick of the ramped load leaves that much; mortar's first case measured 1.1e-3
-/// (NTS on the same pair 8.4 %). Bound 1e-2 of max(p, |τ|) on every stress component next to
-/// the joint and on the contact tractions (NTS on these cases: 6.6–27.7 %); the measured values
-/// are printed and quoted in docs/validation.md §8.
+/// The mesh pairs of the joint-test matrix with a mixed side (lower, upper, slave side).
+const MIXED_PAIRS: [(&str, &str, &str); 4] = [("mixed:4", "hex8:3", "lower"), ("mixed:4", "hex8:3", "upper"), ("hex8:4", "mixed:3", "lower"), ("mixed:4", "mixed:3", "lower")];
+
+/// The mesh pairs of the joint-test matrix (lower, upper, slave side) without a mixed side.
+const HEX_TET_PAIRS: [(&str, &str, &str); 9] = [
+    ("hex8:3", "hex8:3", "upper"),
+    ("hex8:4", "hex8:3", "lower"),
+    ("hex8:4", "hex8:3", "upper"),
+    ("hex8:7", "hex8:5", "lower"),
+    ("hex8:7", "hex8:5", "upper"),
+    ("tet4:4", "hex8:3", "lower"),
+    ("tet4:4", "hex8:3", "upper"),
+    ("tet4:4", "tet4:3", "lower"),
+    ("tet4:3", "hex8:3", "lower"),
+];
+
+/// Pressure and shear (p = 1 MPa, τ = 0.3 MPa) through a tied mortar joint on every hex and tet
+/// pair of the matrix, either side slave: the tie holds the material points that the mortar
+/// integrals of the first step pair (the integrals are kept while nothing slides), so the
+/// uniform state passes. Bound 1e-6 of max(p, |τ|) on σ next to the joint (issue 31; measured
+/// ≤ 7.8e-7, hex 4/3 slave lower) and 2e-6 on the force of each slave node (measured ≤ 1.4e-6,
+/// tet 4/3). Mixed sides are left out: a conforming mixed 3/3 block pair tied node to node
+/// misses uniform shear by 2 % too (the mesh's hex–tet columns, not the joint), checked below
+/// to be the same with mortar. The frictional joint (μ = 0.6) measures 1.5e-4 on hex 4/3 (bound
+/// 2.5e-4): the patch ramps p and τ together from zero, so in the first steps the pairs carry
+/// shear at nearly zero pressure and slip (μ = 10 gives 5.2e-5, conforming NTS with μ = 0.6
+/// 6.6e-5): the testcase's loading path, not the mortar integrals (docs/validation.md §8).
 #[test]
-fn mortar_patch_shear_beats_nts() {
-    let mut worst: f64 = 0.0;
-    for v in [
-        json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "shear": 3e5}),
-        json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "upper", "shear": 3e5}),
-        json!({"kind": "patch", "lower": "tet4:4", "upper": "hex8:3", "slave": "lower", "shear": 3e5}),
-    ] {
-        let mut v = v;
-        v["method"] = json!("mortar");
+fn mortar_patch_shear_passes_on_every_hex_and_tet_pair() {
+    let mut worst: (f64, f64) = (0.0, 0.0);
+    for (lower, upper, slave) in HEX_TET_PAIRS {
+        let v = json!({"kind": "patch", "lower": lower, "upper": upper, "slave": slave, "shear": 3e5, "tied": true, "method": "mortar"});
         let r = case(v.clone());
         let (s, p, t) = patch_errors(&r);
         println!("MEASURED {v}: σ {s:.3e}, pressure {p:.3e}, shear {t:.3e}");
-        worst = worst.max(s).max(p).max(t);
-        assert!(s < 1e-2 && p < 1e-2 && t < 1e-2, "{v}: σ {s:.2e}, pressure {p:.2e}, shear {t:.2e}");
+        worst = (worst.0.max(s), worst.1.max(p).max(t));
+        assert!(s < 1e-6 && p < 2e-6 && t < 2e-6, "{v}: σ {s:.2e}, pressure {p:.2e}, shear {t:.2e}");
     }
-    println!("worst {worst:.2e}");
+    println!("worst σ {:.2e}, node force {:.2e}", worst.0, worst.1);
+    let friction = case(json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "shear": 3e5, "method": "mortar"}));
+    assert!(friction.error < 2.5e-4, "frictional shear σ {:.3e}", friction.error);
+    let mixed = |method: &str| case(json!({"kind": "patch", "lower": "mixed:3", "upper": "mixed:3", "slave": "upper", "shear": 3e5, "tied": true, "method": method})).error;
+    let (ntn, mortar) = (mixed("ntn"), mixed("mortar"));
+    assert!((mortar - ntn).abs() < 1e-6 * ntn, "conforming mixed shear: mortar {mortar:.6e} vs node-to-node {ntn:.6e}");
 }
 
 /// The dynamic kinds with mortar against the NTS figures of docs/validation.md §8 (bounds 1.25 ×
@@ -136,4 +142,53 @@ fn mortar_slide_newmark_and_impact_within_the_nts_errors() {
             assert!(contact_work < 1e-9, "{v}: the contact created energy: work {contact_work:.3e} of the initial kinetic energy");
         }
     }
+}
+
+/// Bounds of the cylindrical joint's σ error on hex 4/3, 8/6, 16/12: 1.25 × measured (2.90e-3,
+/// 1.53e-3, 6.85e-4).
+const BOUNDS_CYL: [f64; 3] = [3.63e-3, 1.92e-3, 8.56e-4];
+/// Bound of the conforming cylinder's σ error (measured 1.3e-10, the static solve's residual).
+const CONFORMING_CYL: f64 = 1e-8;
+
+/// The cylindrical joint (R = 1 m, axis along y; the finer lower side slave) with mortar on three
+/// levels, hex 4/3, 8/6, 16/12 (h halved each time). Reference: the uniform σzz = −p of the
+/// patch kind, exact on the cylinder too (src/testcase/mod.rs). The slave's joint nodes sit on
+/// the master's facets and the mortar joint is grouted on that initial configuration: its
+/// weighted gap sees the two faceted surfaces apart by O(h H / R) where a slave face spans a
+/// master kink, and read as penetration that gave 149 / 120 / 54 % (src/testcase/run.rs).
+/// Measured σ error next to the joint 2.90e-3, 1.53e-3, 6.85e-4: observed orders 0.92 and 1.16,
+/// first order, not the O(h²) issue 31 asked for. The reason: with the faces kept paired, the
+/// tie of the linear exact field u leaves n · ∇u (x̄_j − x_j) per node, where x̄_j = Σ c_k x_k
+/// is the mortar image of the slave node, O(h H / R) off it on a faceted curve, so the strain
+/// error is O(h / R) (measured on hex 4/3: R = 1, 2, 4 m give 2.90e-3, 1.08e-3, 4.76e-4). Bounds:
+/// 1.25 × measured, and both observed orders above 0.8. The conforming cylinder is exact (the
+/// coincident faces give M_jk = D_jj δ_jk: a node-to-node tie).
+#[test]
+fn mortar_cylindrical_joint_converges_at_first_order() {
+    let mut e = Vec::new();
+    for (lower, upper) in [("hex8:4", "hex8:3"), ("hex8:8", "hex8:6"), ("hex8:16", "hex8:12")] {
+        let r = case(json!({"kind": "patch", "lower": lower, "upper": upper, "slave": "lower", "curvature": 1.0, "method": "mortar"}));
+        e.push(r.error);
+    }
+    let order = |a: f64, b: f64| (a / b).log2();
+    println!("MEASURED cylinder mortar σ errors {:.4e} {:.4e} {:.4e}, orders {:.2} {:.2}", e[0], e[1], e[2], order(e[0], e[1]), order(e[1], e[2]));
+    for (got, bound) in e.iter().zip(BOUNDS_CYL) {
+        assert!(*got < bound, "cylinder mortar errors {e:?} above {BOUNDS_CYL:?}");
+    }
+    assert!(order(e[0], e[1]) > 0.8 && order(e[1], e[2]) > 0.8, "observed orders {:.2}, {:.2} (errors {e:?})", order(e[0], e[1]), order(e[1], e[2]));
+    // the conforming cylinder: coincident faces give M = D (biorthogonality), a node-to-node tie
+    let r = case(json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "curvature": 1.0, "method": "mortar"}));
+    assert!(r.error < CONFORMING_CYL, "conforming cylinder mortar σ {:.3e}", r.error);
+}
+
+/// Static stages on mortar joints (issue 31): the coarse dam (pipelines/dam_coarse.json, the
+/// construction sequence) with its contraction joints `method: "mortar"`. Stage c pairs each
+/// slave node with its mortar master point and area D_jj (`statics::contact`), grouting closes
+/// the mortar weighted gap (`statics::sequence::grout_pairs`), so the dynamic stage starts from
+/// the static state of its own pairs. Released at rest with the full reservoir and no record for
+/// 0.2 s, the crown must stay (drift below 1 mm) and the energy balance hold to 1e-9, as for
+/// NTS and NTN (tests/all/dam.rs, `dam_released_at_rest`).
+#[test]
+fn mortar_dam_static_state_stays_at_rest() {
+    super::dam::dam_released_at_rest("mortar", 0.2);
 }

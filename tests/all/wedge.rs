@@ -170,16 +170,17 @@ fn wedge_study_plans_every_level_once_and_the_expensive_runs_first() {
     // base scene) NTS-L1 and NTN on the medium mesh at 5 PGAs, NTS-L2 on medium and fine at
     // 1.0 g, NTS-L1 and NTN on the coarse mesh at 5 PGAs on the rigid and on the massless rock,
     // undamped NTS-L1 and NTN at 1.0 g, the cohesion-loss variant (NTS-L1, NTN, medium, 0.5,
-    // 1.0, 1.5 g), E × 0.5 and × 2 at 1.0 g: 42 runs, no duplicates, the fine run first, one
-    // run with frames (the medium NTS-L1 headline run at 1.0 g, to look at in ParaView).
+    // 1.0, 1.5 g), E × 0.5 and × 2 at 1.0 g, dual mortar on the medium mesh at 1.0 g (issue
+    // 31): 43 runs, no duplicates, the fine run first, one run with frames (the medium NTS-L1
+    // headline run at 1.0 g, to look at in ParaView).
     let (study, kind) = jointquake::studies::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge_study.json"))).unwrap();
     let runs = plan_runs(&study).unwrap();
     let mut ids: Vec<&str> = runs.iter().map(|r| r.id.as_str()).collect();
-    assert_eq!(runs.len(), 10 + 2 + 10 + 10 + 2 + 6 + 2, "{ids:?}");
+    assert_eq!(runs.len(), 10 + 2 + 1 + 10 + 10 + 2 + 6 + 2, "{ids:?}");
     assert_eq!(runs[0].label("mesh"), Some("fine"), "{ids:?}");
     let frames: Vec<&str> = runs.iter().filter(|r| r.overrides.iter().any(|o| o.scene.get("/output/frames") == Some(&json!(true)))).map(|r| r.id.as_str()).collect();
     assert_eq!(frames, ["nts1-medium-pga1.00-ckept-rigidrock"]);
-    for id in ["nts1-medium-pga1.00-ckept-E0.5-rigidrock", "ntn-coarse-pga0.20-ckept-masslessrock", "ntn-medium-pga1.50-closs-rigidrock", "nts1-medium-pga1.00-ckept-undamped-rigidrock", "nts2-medium-pga1.00-ckept-rigidrock"] {
+    for id in ["nts1-medium-pga1.00-ckept-E0.5-rigidrock", "ntn-coarse-pga0.20-ckept-masslessrock", "ntn-medium-pga1.50-closs-rigidrock", "nts1-medium-pga1.00-ckept-undamped-rigidrock", "nts2-medium-pga1.00-ckept-rigidrock", "mortar-medium-pga1.00-ckept-rigidrock"] {
         assert!(ids.contains(&id), "{id} not in {ids:?}");
     }
     ids.sort();

@@ -27,7 +27,8 @@
 //! - **Quadrature**: each overlap polygon (convex) is cut into a fan of triangles from its first
 //!   vertex, each integrated with the 7-point degree-5 rule of Dunavant (1985). On a flat slave
 //!   face and a master face that are parallelograms (or triangles), Φ_j N_k is a polynomial of
-//!   degree ≤ 4 in the plane, integrated exactly. The area element is the slave face's
+//!   degree ≤ 4 in the plane, integrated exactly; when either is a quad of another shape, each
+//!   fan triangle is cut into 6² sub-triangles first (`segment::SUBDIVISIONS`). The area element is the slave face's
 //!   (`|x_ξ × x_η| / |n_0 · (x_ξ × x_η)|` times the plane's; 1 on a flat face).
 //!
 //! Invariants: `Σ_k M_jk = D_j` to round-off for every overlap; the integrals of a face pair do
