@@ -10,7 +10,10 @@
 //! elements enter the stable step), `massless` (the dam study's model: `"massless": true`, the
 //! rock condensed statically, docs/dam_physics.md, by the method the rule picks; its layer
 //! along the tied base keeps its mass), or `solve` / `schur` (massless with that method forced).
-//! The massless variants also report the condensation's size and setup time. Joints: NTS, μ = 0.8, c = 0 (seed section 5), one entry `joint:{J}:left` /
+//! The massless variants also report the condensation's size and setup time. `radiating`
+//! (issue 29): the massed rock with Lysmer dashpots and the free field of the study's three
+//! DL 5073 records on `bc:far` (`foundation.model = "radiating"`, docs/dam_physics.md §4):
+//! its step against the massless one, with its step size. Joints: NTS, μ = 0.8, c = 0 (seed section 5), one entry `joint:{J}:left` /
 //! `joint:{J}:right`; the base `tied`. Loads: gravity plus a uniform 1 MPa downstream traction
 //! on the upstream face (a stand-in for the reservoir that puts the joints in compression, so
 //! that the pairs are active as during shaking). dt = 0.9 × the stable step. One thread.
@@ -20,7 +23,8 @@
 //! outside the other side; with the default 1e-3 those nodes are lost every step (measured: 154
 //! per step on the coarse mesh, none at 0.02).
 //! Knobs: `JQ_DAM_SIZES` (comma list of coarse, default, fine; default "coarse,default"),
-//! `JQ_DAM_ROCK` (comma list of massive, massless, solve, schur; default "massive,massless"),
+//! `JQ_DAM_ROCK` (comma list of massive, massless, solve, schur, radiating; default
+//! "massive,massless,radiating"),
 //! `JQ_BENCH_REPEATS` (default 3), `JQ_BENCH_STEPS` (default 100), `JQ_BENCH_GS_TOL` (Gauss–Seidel
 //! tolerance as a fraction of joint J01's size; default the solver's, 1e-12 of the model size),
 //! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint).
@@ -53,8 +57,8 @@ fn mesh_of(size: &str) -> Result<Mesh, String> {
     Mesh::from_msh(msh).map_err(|e| e.to_string())
 }
 
-fn scene(massless: bool) -> Scene {
-    let v: serde_json::Value = serde_json::json!({
+fn scene(massless: bool, radiating: bool) -> Scene {
+    let mut v: serde_json::Value = serde_json::json!({
         "geometry": {"msh": "unused.msh"},
         "materials": [{"group": "block:monolith:*", "E": 24e9, "nu": 0.17, "rho": 2400.0},
                       {"group": "block:rock", "E": 24.5e9, "nu": 0.25, "rho": 2000.0, "massless": massless}],
@@ -66,6 +70,15 @@ fn scene(massless: bool) -> Scene {
         "loads": {"gravity": {}, "traction": [{"group": "face:upstream", "traction": [0.0, 1e6, 0.0]}]},
         "time": {"duration": 1.0, "energy_tolerance": 1.0}
     });
+    if radiating {
+        let rec = |c: &str| root().join(format!("pipelines/records/dam_dl5073_arch_I_s1_{c}.txt")).to_string_lossy().to_string();
+        v["loads"]["base"] = serde_json::json!([
+            {"record": rec("h1"), "direction": [1, 0, 0]},
+            {"record": rec("h2"), "direction": [0, 1, 0]},
+            {"record": rec("v"), "direction": [0, 0, 1]}
+        ]);
+        v["foundation"] = serde_json::json!({"model": "radiating"});
+    }
     serde_json::from_value(v).expect("bench scene")
 }
 
@@ -85,7 +98,7 @@ fn main() {
     let repeats: usize = std::env::var("JQ_BENCH_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(3usize).max(1);
     let steps: usize = std::env::var("JQ_BENCH_STEPS").ok().and_then(|v| v.parse().ok()).unwrap_or(100usize).max(1);
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
-    let rocks = std::env::var("JQ_DAM_ROCK").unwrap_or_else(|_| "massive,massless".into());
+    let rocks = std::env::var("JQ_DAM_ROCK").unwrap_or_else(|_| "massive,massless,radiating".into());
     println!("arch dam benchmark (1 thread, load average {load}); rock variants {rocks}");
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let mut rows = Vec::new();
@@ -102,13 +115,13 @@ fn main() {
             let t_mesh = t0.elapsed().as_secs_f64();
             for rock in rocks.split(',').map(str::trim).filter(|s| !s.is_empty()) {
                 let method = match rock {
-                    "massive" | "massless" => None,
+                    "massive" | "massless" | "radiating" => None,
                     "solve" => Some(CondensationMethod::Solve),
                     "schur" => Some(CondensationMethod::Schur),
-                    other => panic!("JQ_DAM_ROCK: unknown rock variant \"{other}\" (massive, massless, solve, schur)"),
+                    other => panic!("JQ_DAM_ROCK: unknown rock variant \"{other}\" (massive, massless, solve, schur, radiating)"),
                 };
                 let mesh = mesh.clone();
-                let mut sc = scene(rock != "massive");
+                let mut sc = scene(rock != "massive", rock == "radiating");
                 jointquake::pipeline::expand_patterns(&mut sc, &mesh, std::path::Path::new("benches/dam.rs")).expect("patterns expand on the dam mesh");
                 let t1 = Instant::now();
                 let problem = Problem::build(sc, mesh).expect("dam model");
@@ -118,6 +131,9 @@ fn main() {
                 let mut sim = Simulation::with_condensation(&problem, method).expect("dam simulation");
                 let t_sim = t2.elapsed().as_secs_f64();
                 let found = sim.foundation.as_ref().map(|f| f.info(t_sim));
+                if let Some(far) = &problem.far_boundary {
+                    println!("  {size}, rock {rock}: {} far nodes with dashpots and free-field forces, {} far faces ({:.3e} m²), free-field delay {:.3} s", far.nodes.len(), far.faces, far.area, far.free_field.delay);
+                }
                 let (dt_stable, dt) = (sim.time.dt_stable, sim.dt());
                 if let Some(r) = std::env::var("JQ_BENCH_GS_TOL").ok().and_then(|v| v.parse::<f64>().ok()) {
                     sim.contact.as_mut().expect("joints").gs_tolerance = r * problem.joints[0].tag.size;
@@ -242,7 +258,7 @@ fn reservoir_models(repeats: usize, steps: usize) -> Vec<serde_json::Value> {
         };
         let mut base_step = f64::NAN;
         for model in ["westergaard", "fe_incompressible", "acoustic"] {
-            let mut v = serde_json::to_value(scene(true)).expect("bench scene");
+            let mut v = serde_json::to_value(scene(true, false)).expect("bench scene");
             v["loads"] = serde_json::json!({"gravity": {}});
             v["reservoir"] = serde_json::json!({"faces": ["face:upstream"], "level": 205.0, "model": model});
             if model != "westergaard" {

@@ -20,8 +20,10 @@
 //! normal of the upstream crest arch y = x² / (2 Rc) at the monitor, (−x/Rc, 1, 0) normalised.
 
 pub mod convergence;
+pub mod decay;
 pub mod face_maps;
 pub mod joint_maps;
+pub mod models_table;
 pub mod paraview_state;
 pub mod report;
 pub mod static_table;
@@ -67,6 +69,37 @@ pub struct DamParams {
     pub enough: f64,
     /// The seed paper's numbers the tables compare with.
     pub seed: SeedNumbers,
+    /// Free-vibration runs after a pulse (f1 and the first mode's damping per model,
+    /// [`models_table`]). Default: none (no run is a pulse run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pulse: Option<PulseParams>,
+}
+
+/// The study's free-vibration runs: which runs they are and where their decay is fitted
+/// ([`decay`]).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PulseParams {
+    /// The axis label of the pulse runs (a value of any axis, e.g. of `level`, that replaces the
+    /// records by a pulse and sets no `pga`).
+    pub label: String,
+    /// Start of the fitted window [s]: after the pulse has passed the dam (its length plus,
+    /// for a radiating rock, the free field's delay). Default 1.2 (the 0.6 s pulse of
+    /// pipelines/records/pulse_sin4_T0.6.txt, the 0.285 s delay of the dam's 630 m column and
+    /// 0.3 s for the rock's scattered waves to leave).
+    #[serde(default = "pulse_start")]
+    pub start: f64,
+    /// Band searched for f1 [Hz]. Default [0.4, 2.5]: the dam's first mode, 0.88 Hz full to
+    /// 1.37 Hz empty (docs/dam.md "Modes"), with room either side.
+    #[serde(default = "pulse_band")]
+    pub band: [f64; 2],
+}
+
+fn pulse_start() -> f64 {
+    1.2
+}
+fn pulse_band() -> [f64; 2] {
+    [0.4, 2.5]
 }
 
 #[derive(Clone, Debug, Deserialize, Serialize)]
@@ -91,6 +124,15 @@ pub struct Monitors {
     pub crown: String,
     pub quarter_left: String,
     pub quarter_right: String,
+    /// The dam's foot under the crown (on the rock's side of the base): the pulse runs' crown
+    /// motion is taken relative to it (a radiating rock's displacements are total, and with
+    /// dashpots alone it may drift as a whole). Default "dam_foot"; only the pulse runs need it.
+    #[serde(default = "foot")]
+    pub foot: String,
+}
+
+fn foot() -> String {
+    "dam_foot".into()
 }
 
 impl Default for Monitors {
@@ -99,6 +141,7 @@ impl Default for Monitors {
             crown: "crest_crown".into(),
             quarter_left: "crest_quarter_left".into(),
             quarter_right: "crest_quarter_right".into(),
+            foot: foot(),
         }
     }
 }
@@ -216,6 +259,12 @@ impl FaceStress {
 pub struct DamRun {
     pub id: String,
     pub method: Method,
+    /// The reservoir model of its scene ([`reservoir_label`]) and its foundation model.
+    pub reservoir: String,
+    pub foundation: String,
+    /// A free-vibration run after a pulse (`report.pulse`): level 0, read by the models table
+    /// only.
+    pub pulse: bool,
     /// PGA over the design PGA.
     pub level: f64,
     pub mesh: String,
@@ -239,6 +288,11 @@ pub struct DamRun {
     /// Crest radial displacement histories (crown, left and right quarter points): (t, u_r) [s, m].
     #[serde(skip)]
     pub crest: Vec<(String, Vec<(f64, f64)>)>,
+    /// Pulse runs: the crown monitor's cross-stream displacement relative to the dam's foot,
+    /// (t, u_x − u_x,foot) [s, m] (the antisymmetric first mode moves the crown along the
+    /// crest; the decay is fitted to it). Empty for the other runs.
+    #[serde(skip)]
+    pub crown_x: Vec<(f64, f64)>,
     /// The opening history (largest over the joint) of the joint with the largest opening.
     #[serde(skip)]
     pub worst_joint_history: Vec<(f64, f64)>,
@@ -256,6 +310,28 @@ impl DamRun {
     }
     pub fn is_main(&self, p: &DamParams) -> bool {
         self.mesh == p.main_mesh
+    }
+    /// The seed's model (westergaard reservoir, massless rock) under an earthquake: the runs
+    /// every section but the models table reads.
+    pub fn is_seed_model(&self) -> bool {
+        !self.pulse && self.reservoir == SEED_RESERVOIR && self.foundation == SEED_FOUNDATION
+    }
+}
+
+/// The seed's reservoir and foundation models (the scene defaults).
+pub const SEED_RESERVOIR: &str = "westergaard";
+pub const SEED_FOUNDATION: &str = "massless";
+
+/// The reservoir model of a scene: `"none"` without a reservoir, `"empty"` without its added
+/// mass, `"westergaard_local"` for Westergaard with each section's depth (either spelling),
+/// else the model's name.
+pub fn reservoir_label(scene: &Scene) -> String {
+    use crate::scene::reservoir::ReservoirModel;
+    match &scene.reservoir {
+        None => "none".into(),
+        Some(r) if !r.added_mass => "empty".into(),
+        Some(r) if r.model == ReservoirModel::Westergaard && r.added_mass_depth == crate::scene::AddedMassDepth::Local => ReservoirModel::WestergaardLocal.name().into(),
+        Some(r) => r.model.name().into(),
     }
 }
 
@@ -386,12 +462,14 @@ impl DamKind {
         let method = self
             .method_of(scene)
             .map_err(|m| OutputError::read(&r.dir, m))?;
-        let pga = r.spec.pga.ok_or_else(|| {
-            OutputError::read(
-                &r.dir,
-                "the run sets no `pga` (the level axis must set `pga`)",
-            )
-        })?;
+        let pulse = p.pulse.as_ref().is_some_and(|q| r.spec.labels.iter().any(|(_, l)| *l == q.label));
+        let pga = match (r.spec.pga, pulse) {
+            (_, true) => 0.0,
+            (Some(pga), false) => pga,
+            (None, false) => {
+                return Err(OutputError::read(&r.dir, "the run sets no `pga` (the level axis must set `pga`; a pulse run must carry `report.pulse.label`)").into());
+            }
+        };
         let mesh = r
             .spec
             .label(&p.mesh_axis)
@@ -461,9 +539,21 @@ impl DamKind {
         ] {
             crest.push((m.clone(), self.crest_history(r, m)?));
         }
+        // the pulse runs: the crown's u_x relative to the dam's foot
+        let crown_x = if pulse {
+            let (h, f): (HistoryTable, HistoryTable) = (r.history(&p.monitors.crown)?, r.history(&p.monitors.foot)?);
+            let (t, ux, fx) = (h.column("t")?, h.column("ux")?, f.column("ux")?);
+            t.iter().zip(ux).zip(fx).map(|((&t, &u), &f)| (t, u - f)).collect()
+        } else {
+            Vec::new()
+        };
         Ok(DamRun {
+            crown_x,
             id: r.spec.id.clone(),
             method,
+            reservoir: reservoir_label(scene),
+            foundation: scene.foundation.as_ref().map(|f| f.model.as_str()).unwrap_or(SEED_FOUNDATION).to_string(),
+            pulse,
             level: pga / p.design_pga,
             mesh,
             wall_time: r.summary.as_ref().map(|s| s.wall_time),
@@ -505,6 +595,17 @@ impl StudyKind for DamKind {
         }
         if !(p.enough.is_finite() && p.enough > 0.0) {
             return Err(invalid(format!("`enough` = {} must be positive", p.enough)));
+        }
+        if let Some(q) = &p.pulse {
+            if !(q.start.is_finite() && q.start >= 0.0) {
+                return Err(invalid(format!("`pulse.start` = {} must be a time ≥ 0 [s]", q.start)));
+            }
+            if !(q.band[0] > 0.0 && q.band[1] > q.band[0] && q.band[1].is_finite()) {
+                return Err(invalid(format!("`pulse.band` = {:?} must be [low, high] with 0 < low < high [Hz]", q.band)));
+            }
+            if !study.axes.iter().any(|a| a.values.iter().any(|v| v.label == q.label)) {
+                return Err(invalid(format!("`pulse.label` = \"{}\" is the label of no axis value", q.label)));
+            }
         }
         let s = &p.seed;
         if s.opening_nts_mm.len() != s.levels.len() || s.opening_ntn_mm.len() != s.levels.len() {

@@ -74,6 +74,9 @@ pub struct DamReport<'a> {
     pub kind: &'a DamKind,
     pub results: &'a StudyResults<'a>,
     pub runs: Vec<DamRun>,
+    /// Every run read, the other reservoir and foundation models and the pulse runs too (the
+    /// models table's); `runs` holds the seed's model only.
+    pub all: Vec<DamRun>,
     /// Runs whose results could not be read: (id, why).
     pub unreadable: Vec<(String, String)>,
     /// Distinct levels, ascending.
@@ -85,14 +88,15 @@ pub struct DamReport<'a> {
 impl<'a> DamReport<'a> {
     /// Reads every run with results through [`DamKind::run`].
     pub fn read(kind: &'a DamKind, results: &'a StudyResults<'a>) -> DamReport<'a> {
-        let mut runs: Vec<DamRun> = Vec::new();
+        let mut all: Vec<DamRun> = Vec::new();
         let mut unreadable = Vec::new();
         for r in results.runs.iter().filter(|r| r.has_results()) {
             match kind.run(r) {
-                Ok(x) => runs.push(x),
+                Ok(x) => all.push(x),
                 Err(e) => unreadable.push((r.spec.id.clone(), e.to_string())),
             }
         }
+        let mut runs: Vec<DamRun> = all.iter().filter(|x| x.is_seed_model()).cloned().collect();
         runs.sort_by(|a, b| {
             a.level
                 .total_cmp(&b.level)
@@ -106,6 +110,7 @@ impl<'a> DamReport<'a> {
             kind,
             results,
             runs,
+            all,
             unreadable,
             levels,
             top,
@@ -162,6 +167,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     super::joint_maps::joint_maps_section(&r, &mut doc)?;
     super::paraview_state::paraview_state_section(&r, &mut doc)?;
     super::joint_maps::lost_nodes_section(&r, &mut doc);
+    super::models_table::models_table_section(&r, &mut doc);
     histories_section(&r, &mut doc)?;
     let claims = claims(kind, &r.runs, &r.levels);
     claims_section(&claims, &mut doc);
@@ -188,7 +194,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
             c.claim
         ));
     }
-    let json = serde_json::json!({ "runs": r.runs, "claims": claims, "accuracy": acc });
+    let json = serde_json::json!({ "runs": r.runs, "claims": claims, "accuracy": acc, "models": super::models_table::model_rows(&r) });
     Ok(KindReport {
         markdown: doc.md,
         json,
