@@ -125,6 +125,25 @@ struct MortarJoint {
     rows: Vec<MortarRow>,
 }
 
+impl MortarJoint {
+    /// Empty integrals sized for joint `j`: a face per slave face, a row per slave node, none
+    /// evaluated.
+    fn sized(j: &ContactJoint) -> MortarJoint {
+        let n_s = j.tag.n_slave();
+        MortarJoint { faces: vec![FaceIntegrals::default(); j.tag.slave.faces.len()], d: vec![0.0; n_s], rows: vec![([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0); n_s] }
+    }
+}
+
+/// The error of a slave node `i` of mortar joint `j` with more than `MORTAR_MASTERS` master
+/// nodes (the dynamic pairs and the static stages alike).
+fn mortar_overflow(j: &ContactJoint, i: usize) -> StepError {
+    StepError::Contact(format!(
+        "joint \"{}\" (mortar): slave node {} couples to more than {MORTAR_MASTERS} master nodes: the slave side is far coarser than the master. Make the finer side the slave (`auto`, or swap `master` and `slave`) or refine the slave side",
+        j.tag.name,
+        j.tag.slave_nodes()[i]
+    ))
+}
+
 /// The mortar pairs of the current step and the scratch of their integrals, apart from the
 /// node-to-segment pairs because a mortar slave node has more master nodes than a face's four.
 #[derive(Default)]
@@ -838,17 +857,11 @@ impl ContactSolver<'_> {
         }
         let mut mj = std::mem::take(&mut self.mortar.joints[ji]);
         if mj.faces.len() != j.tag.slave.faces.len() || mj.d.len() != n_s {
-            mj.faces = vec![FaceIntegrals::default(); j.tag.slave.faces.len()];
-            mj.d = vec![0.0; n_s];
-            mj.rows = vec![([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0); n_s];
+            mj = MortarJoint::sized(j);
         }
         let overflow = self.mortar_integrals_into(model, j, rec, u_next, &mut mj);
         if let Some(i) = overflow {
-            return Err(StepError::Contact(format!(
-                "joint \"{}\" (mortar): slave node {} couples to more than {MORTAR_MASTERS} master nodes: the slave side is far coarser than the master. Make the finer side the slave (`auto`, or swap `master` and `slave`) or refine the slave side",
-                j.tag.name,
-                j.tag.slave_nodes()[i]
-            )));
+            return Err(mortar_overflow(j, i));
         }
         let ms = &j.tag.master;
         for i in 0..n_s {
@@ -898,9 +911,9 @@ impl ContactSolver<'_> {
     pub fn mortar_master_points(&mut self, model: &Model, ji: usize, rec: &JointRecord, u: &[f64]) -> Result<Vec<Option<(Vec<(usize, f64)>, f64)>>, StepError> {
         let j = &self.joints[ji];
         let n_s = j.tag.n_slave();
-        let mut mj = MortarJoint { faces: vec![FaceIntegrals::default(); j.tag.slave.faces.len()], d: vec![0.0; n_s], rows: vec![([0; MORTAR_MASTERS], [0.0; MORTAR_MASTERS], 0); n_s] };
+        let mut mj = MortarJoint::sized(j);
         if let Some(i) = self.mortar_integrals_into(model, j, rec, u, &mut mj) {
-            return Err(StepError::Contact(format!("joint \"{}\" (mortar): slave node {} couples to more than {MORTAR_MASTERS} master nodes: make the finer side the slave", j.tag.name, j.tag.slave_nodes()[i])));
+            return Err(mortar_overflow(j, i));
         }
         Ok((0..n_s)
             .map(|i| {
