@@ -16,7 +16,8 @@
 //! its step against the massless one, with its step size. Joints: NTS, μ = 0.8, c = 0 (seed section 5), one entry `joint:{J}:left` /
 //! `joint:{J}:right`; the base `tied`. Loads: gravity plus a uniform 1 MPa downstream traction
 //! on the upstream face (a stand-in for the reservoir that puts the joints in compression, so
-//! that the pairs are active as during shaking). dt = 0.9 × the stable step. One thread.
+//! that the pairs are active as during shaking). dt = 0.9 × the stable step. One thread unless
+//! `JQ_BENCH_THREADS` says more.
 //! 100 warm-up steps, then `repeats` × `steps` timed steps; best and median reported.
 //! Joints use `edge_tolerance` 0.02: their curved edges are cut into chords at different nodes
 //! on the two sides, so an edge node lies up to the chord sagitta (0.12 m on the coarse mesh)
@@ -27,7 +28,13 @@
 //! "massive,massless,radiating"),
 //! `JQ_BENCH_REPEATS` (default 3), `JQ_BENCH_STEPS` (default 100), `JQ_BENCH_GS_TOL` (Gauss–Seidel
 //! tolerance as a fraction of joint J01's size; default the solver's, 1e-12 of the model size),
-//! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint).
+//! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint), `JQ_BENCH_THREADS`
+//! (comma list of thread counts, default "1": the first builds the model and times the steps as
+//! above; each further count times as many steps more, in its own rayon pool, with its speed-up
+//! over the first and the bound Amdahl's law puts on it with the contact correction serial; a
+//! loaded machine shares its cores, so time the threads on an idle one). Every run also prints
+//! the process's CPU time per step (all threads; /proc/self/task/*/schedstat), which a load on
+//! the machine inflates far less than the wall time.
 //! Then the step with each reservoir model against Westergaard's (`reservoir_models`, knob
 //! `JQ_DAM_RESERVOIR`, default "coarse").
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
@@ -89,6 +96,14 @@ fn median(v: &[f64]) -> f64 {
     if n % 2 == 1 { s[n / 2] } else { 0.5 * (s[n / 2 - 1] + s[n / 2]) }
 }
 
+/// CPU time of this process [s], all its threads (the first field of each thread's
+/// /proc/self/task/*/schedstat: ns on a CPU), so that a step can be timed apart from the
+/// machine's load; NaN where /proc is missing.
+fn cpu_s() -> f64 {
+    let Ok(dir) = std::fs::read_dir("/proc/self/task") else { return f64::NAN };
+    dir.flatten().filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok()).filter_map(|s| s.split_whitespace().next()?.parse::<f64>().ok()).sum::<f64>() * 1e-9
+}
+
 fn best(v: &[f64]) -> f64 {
     v.iter().copied().fold(f64::INFINITY, f64::min)
 }
@@ -99,8 +114,11 @@ fn main() {
     let steps: usize = std::env::var("JQ_BENCH_STEPS").ok().and_then(|v| v.parse().ok()).unwrap_or(100usize).max(1);
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
     let rocks = std::env::var("JQ_DAM_ROCK").unwrap_or_else(|_| "massive,massless,radiating".into());
-    println!("arch dam benchmark (1 thread, load average {load}); rock variants {rocks}");
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let threads: Vec<usize> = std::env::var("JQ_BENCH_THREADS").unwrap_or_else(|_| "1".into()).split(',').filter_map(|t| t.trim().parse().ok()).filter(|&t| t > 0).collect();
+    let threads = if threads.is_empty() { vec![1] } else { threads };
+    let pools: Vec<(usize, rayon::ThreadPool)> = threads.iter().map(|&t| (t, rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap())).collect();
+    let pool = &pools[0].1;
+    println!("arch dam benchmark (threads {threads:?}, load average {load}); rock variants {rocks}");
     let mut rows = Vec::new();
     pool.install(|| {
         for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
@@ -154,10 +172,21 @@ fn main() {
                 let events0: Vec<(u64, u64, u64, u64)> = sim.state.contact.joints.iter().map(|j| (j.events.fresh_searches, j.events.recentred, j.events.lost, j.events.projection_failures)).collect();
                 sim.contact.as_mut().expect("joints").timings = Some(Default::default());
                 let mut per_step = Vec::new();
+                let cpu0 = cpu_s();
                 for _ in 0..repeats {
                     per_step.push(step(steps, &mut sim, &mut sweeps) / steps as f64);
                 }
                 let timed = (repeats * steps) as f64;
+                let cpu_step = (cpu_s() - cpu0) / timed;
+                let parts = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
+                // the same steps on each further thread count (after the one-thread steps: the
+                // state moves on, the contact's pairs and sweeps stay about the same)
+                let mut threads_rows = Vec::new();
+                for (nt, p) in pools.iter().skip(1) {
+                    let (mut sw, c0) = (0usize, cpu_s());
+                    let t: Vec<f64> = p.install(|| (0..repeats).map(|_| step(steps, &mut sim, &mut sw) / steps as f64).collect());
+                    threads_rows.push((*nt, t, (cpu_s() - c0) / timed, sw as f64 / timed));
+                }
                 let sweeps_per_step = sweeps as f64 / timed;
                 let unconverged: u64 = sim.state.contact.joints.iter().map(|j| j.unconverged_steps).sum();
                 let (mut fresh, mut recentred, mut lost, mut failures) = (0u64, 0u64, 0u64, 0u64);
@@ -168,7 +197,6 @@ fn main() {
                     failures += j.events.projection_failures - e0.3;
                 }
                 let active: usize = sim.state.contact.joints.iter().map(|j| j.pairs.iter().filter(|p| p.r_n > 0.0).count()).sum();
-                let parts = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
                 let contact = (parts.search + parts.prepare + parts.sweeps + parts.record).as_secs_f64() / parts.steps.max(1) as f64;
                 let (b, m) = (best(&per_step), median(&per_step));
                 let ne = model.n_elements();
@@ -195,6 +223,14 @@ fn main() {
                 );
                 println!("    mesh {t_mesh:.2} s, model build and tagging {t_build:.2} s; stable dt {dt_stable:.4e} s (critical element {} in {}), dt {dt:.4e} s", model.critical.tag, model.critical.group);
                 println!("    step {:.3} / {:.3} ms (best / median of {repeats} × {steps}); {:.3} µs per element; contact {:.3} ms per step = {:.3} µs per slave node", 1e3 * b, 1e3 * m, 1e6 * m / ne as f64, 1e3 * contact, 1e6 * contact / slaves.max(1) as f64);
+                let serial = contact / m;
+                println!("    CPU time {:.3} ms per step ({} thread{}, all threads); the contact (serial) {:.0} % of the step", 1e3 * cpu_step, pools[0].0, if pools[0].0 == 1 { "" } else { "s" }, 1e2 * serial);
+                let mut threads_json = Vec::new();
+                for (nt, t, cpu, sw) in &threads_rows {
+                    let amdahl = 1.0 / (serial + (1.0 - serial) * pools[0].0 as f64 / *nt as f64);
+                    println!("    {nt} threads: step {:.3} / {:.3} ms, {:.2}× the {}-thread median (Amdahl bound with the serial contact: {amdahl:.2}×); CPU time {:.3} ms per step; {sw:.1} sweeps per step", 1e3 * best(t), 1e3 * median(t), m / median(t), pools[0].0, 1e3 * cpu);
+                    threads_json.push(serde_json::json!({"threads": nt, "step_s": t, "best_step_s": best(t), "median_step_s": median(t), "speedup_median": m / median(t), "amdahl_bound": amdahl, "cpu_s_per_step": cpu, "gs_sweeps_per_step": sw}));
+                }
                 println!(
                     "    Gauss–Seidel {sweeps_per_step:.1} sweeps per step ({unconverged} unconverged steps since the start); per timed step: {:.2} fresh searches, {:.2} recentred, {:.2} lost, {:.2} projection failures",
                     fresh as f64 / timed,
@@ -216,6 +252,7 @@ fn main() {
                     "contact_s_per_step": contact, "contact_us_per_slave_node": 1e6 * contact / slaves.max(1) as f64,
                     "wall_s_per_earthquake_second": per_second, "gs_sweeps_per_step": sweeps_per_step, "unconverged_steps": unconverged,
                     "fresh_searches_per_step": fresh as f64 / timed, "recentred_per_step": recentred as f64 / timed, "lost_per_step": lost as f64 / timed, "mesh_s": t_mesh, "build_s": t_build,
+                    "threads": pools[0].0, "cpu_s_per_step": cpu_step, "contact_share": serial, "other_threads": threads_json,
                 }));
             }
         }
