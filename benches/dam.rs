@@ -224,7 +224,9 @@ fn main() {
                 println!("    mesh {t_mesh:.2} s, model build and tagging {t_build:.2} s; stable dt {dt_stable:.4e} s (critical element {} in {}), dt {dt:.4e} s", model.critical.tag, model.critical.group);
                 println!("    step {:.3} / {:.3} ms (best / median of {repeats} × {steps}); {:.3} µs per element; contact {:.3} ms per step = {:.3} µs per slave node", 1e3 * b, 1e3 * m, 1e6 * m / ne as f64, 1e3 * contact, 1e6 * contact / slaves.max(1) as f64);
                 let serial = contact / m;
-                println!("    CPU time {:.3} ms per step ({} thread{}, all threads); the contact (serial) {:.0} % of the step", 1e3 * cpu_step, pools[0].0, if pools[0].0 == 1 { "" } else { "s" }, 1e2 * serial);
+                let part = |d: std::time::Duration| d.as_secs_f64() / parts.steps.max(1) as f64 / m;
+                let shares = [part(parts.search), part(parts.prepare), part(parts.sweeps), part(parts.record)];
+                println!("    CPU time {:.3} ms per step ({} thread{}, all threads); the contact (serial) {:.0} % of the step: search {:.0} %, prepare {:.0} %, sweeps {:.0} %, record {:.0} %", 1e3 * cpu_step, pools[0].0, if pools[0].0 == 1 { "" } else { "s" }, 1e2 * serial, 1e2 * shares[0], 1e2 * shares[1], 1e2 * shares[2], 1e2 * shares[3]);
                 let mut threads_json = Vec::new();
                 for (nt, t, cpu, sw) in &threads_rows {
                     let amdahl = 1.0 / (serial + (1.0 - serial) * pools[0].0 as f64 / *nt as f64);
@@ -252,7 +254,7 @@ fn main() {
                     "contact_s_per_step": contact, "contact_us_per_slave_node": 1e6 * contact / slaves.max(1) as f64,
                     "wall_s_per_earthquake_second": per_second, "gs_sweeps_per_step": sweeps_per_step, "unconverged_steps": unconverged,
                     "fresh_searches_per_step": fresh as f64 / timed, "recentred_per_step": recentred as f64 / timed, "lost_per_step": lost as f64 / timed, "mesh_s": t_mesh, "build_s": t_build,
-                    "threads": pools[0].0, "cpu_s_per_step": cpu_step, "contact_share": serial, "other_threads": threads_json,
+                    "threads": pools[0].0, "cpu_s_per_step": cpu_step, "contact_share": serial, "contact_shares_search_prepare_sweeps_record": shares, "other_threads": threads_json,
                 }));
             }
         }
