@@ -380,6 +380,7 @@ impl Recorder {
             interrupted_phase: None,
             history_rows_every: self.hist_stride as f64 * sim.dt(),
             warnings: self.warnings(sim),
+            water: sim.water.as_ref().map(|w| w.stats.clone()),
         }
     }
 

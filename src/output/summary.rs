@@ -91,6 +91,10 @@ pub struct RunSummary {
     /// written before jointquake recorded it.
     #[serde(default)]
     pub provenance: Option<Provenance>,
+    /// The acoustic reservoir's water (`reservoir.model: "acoustic"`): its step beside the
+    /// solid's, its peak dynamic pressure and cavitation counts; absent for the other models.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub water: Option<crate::problem::reservoir::acoustic::WaterSummary>,
 }
 
 /// Where and how a run ran (`summary.json` → `provenance`).
@@ -199,6 +203,7 @@ impl RunSummary {
             history_rows_every: 0.0,
             warnings: Vec::new(),
             provenance: Some(Provenance::of_this_process()),
+            water: None,
         }
     }
 
@@ -228,6 +233,9 @@ impl RunSummary {
                 _ => String::new(),
             }
         );
+        if let Some(w) = &self.water {
+            let _ = writeln!(s, "  water           {}", w.line());
+        }
         let _ = writeln!(s, "  steps           {} over {} s on {} thread{}", self.steps, self.duration, self.threads, if self.threads == 1 { "" } else { "s" });
         if let Some(eq) = &self.equilibrium {
             let _ = writeln!(s, "  gravity         equilibrium in {} steps, residual {:.2e}{}", eq.steps, eq.residual, if eq.converged { "" } else { " (NOT converged)" });

@@ -206,11 +206,44 @@ const SIDES_AND_BOTTOM: [&str; 5] = ["rock:x0", "rock:x1", "rock:y0", "rock:y1",
 /// under the three components of the DL 5073 arch record taken as the surface free field, is
 /// the 1-D column itself: every top-surface node's acceleration equals the free field's surface
 /// motion (the record low-passed at 25 Hz, delayed by the travel time) within 5 % of its peak,
-/// per component, over 6 s: issue 29's tolerance, NOT met yet. Measured 7.7 / 7.6 / 7.5 % (x,
-/// y, z) with 2.5 m hexes and 6.2 % (x) with 5 m hexes, so the misfit is not the mesh's
-/// dispersion; its cause is open (docs/dam_physics.md §4, "What is left"). This test guards
-/// the measured state at 10 %; the 5 % check is the ignored test below.
-fn radiating_box_top_check(limit: f64) {
+/// per component, over 6 s: issue 29's tolerance. Its velocity within 1 % of the free field's
+/// surface velocity peak.
+///
+/// The bug this guards (issue 29, "What is left"): with the free field sampled 4 times per
+/// record interval the acceleration misfit was 7.7 / 7.6 / 7.5 % (velocity 0.04 / 0.06 / 0.6 %):
+/// the boundary forces, linear in time between samples, kink at every sample and ring the box's
+/// highest modes. Measured 3.1 / 3.0 / 2.8 % at 8 samples (the default now,
+/// `free_field::SUBSAMPLES`) and 0.56 / 0.55 / 0.92 % at 16; 10 × finer depth levels left the
+/// 7.7 % unchanged. So the test also checks the cause: sampled twice finer again, the misfit
+/// falls by more than half.
+#[test]
+fn radiating_box_top_moves_with_the_free_field_record_within_5_percent() {
+    let m = radiating_box_top_misfits(2.5);
+    for c in 0..3 {
+        assert!(m.accel[c] < 0.05, "component {c}: acceleration misfit {:.4} of peak", m.accel[c]);
+        assert!(m.vel[c] < 0.01, "component {c}: velocity misfit {:.4} of peak", m.vel[c]);
+    }
+    let fine = radiating_box_top_misfits_with(2.5, 2);
+    for c in 0..3 {
+        assert!(fine.accel[c] < 0.5 * m.accel[c], "component {c}: the free field's time sampling should set the misfit: {:.4} at twice the samples against {:.4}", fine.accel[c], m.accel[c]);
+    }
+}
+
+/// The top-surface misfits of the radiating box with hexes of `h` [m] (the largest over the top
+/// nodes and the run), as fractions of the free field's surface peak, per component:
+/// acceleration (`accel`) and velocity (`vel`).
+struct TopMisfits {
+    accel: [f64; 3],
+    vel: [f64; 3],
+}
+
+fn radiating_box_top_misfits(h: f64) -> TopMisfits {
+    radiating_box_top_misfits_with(h, 1)
+}
+
+/// [`radiating_box_top_misfits`] with the free field sampled `time_factor` times finer in time
+/// (`FreeField::refined`, the same depth levels).
+fn radiating_box_top_misfits_with(h: f64, time_factor: usize) -> TopMisfits {
     let rec = |f: &str| record_path(f).to_string_lossy().to_string();
     let sc = scene(serde_json::json!({
         "geometry": {"msh": "box.msh"},
@@ -223,46 +256,47 @@ fn radiating_box_top_check(limit: f64) {
         "time": {"duration": 6.0},
         "foundation": {"model": "radiating", "rock": ["block:rock"], "far": SIDES_AND_BOTTOM}
     }));
-    let p = Problem::build(sc, rock_box([10.0, 10.0, 200.0], [4, 4, 80])).unwrap();
+    let n = (10.0 / h).round() as usize;
+    let mut p = Problem::build(sc, rock_box([10.0, 10.0, 200.0], [n, n, 20 * n])).unwrap();
+    if time_factor > 1 {
+        let nodes = p.model.mesh.nodes.clone();
+        let far = p.far_boundary.as_mut().expect("radiating");
+        far.free_field = far.free_field.refined(time_factor, far.free_field.levels());
+        far.depth = far.nodes.iter().map(|&k| far.free_field.depth_weight(nodes[k][2])).collect();
+    }
     let far = p.far_boundary.as_ref().expect("radiating");
     let ff = &far.free_field;
     let top: Vec<usize> = (0..p.model.n_nodes()).filter(|&n| p.model.mesh.nodes[n][2] > 199.9).collect();
+    let surface = ff.depth_weight(200.0);
     let mut sim = Simulation::new(&p).unwrap();
     let steps = ((6.0 + ff.delay) / sim.dt()) as usize;
-    let (mut err, mut pk, mut at) = ([0.0f64; 3], [0.0f64; 3], [(0.0, 0.0, 0.0); 3]);
+    let (mut ea, mut ev, mut pa, mut pv) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
+    let mut at = [(0.0, 0.0, 0.0); 3];
     for _ in 0..steps {
         sim.step().unwrap();
         let k = sim.kinematics();
+        let v_ff = ff.at(surface, k.t).vel;
         for c in 0..3 {
             let a_ff = ff.surface_accel_at(c, k.t);
-            pk[c] = pk[c].max(a_ff.abs());
+            pa[c] = pa[c].max(a_ff.abs());
+            pv[c] = pv[c].max(v_ff[c].abs());
             for &n in &top {
                 let e = (k.acceleration(3 * n + c) - a_ff).abs();
-                if e > err[c] {
-                    err[c] = e;
+                if e > ea[c] {
+                    ea[c] = e;
                     at[c] = (k.t, a_ff, k.acceleration(3 * n + c));
                 }
+                ev[c] = ev[c].max((k.velocity(3 * n + c) - v_ff[c]).abs());
             }
         }
     }
     for c in 0..3 {
-        eprintln!("component {c}: top misfit {:.2} % of peak {:.3} m/s² (at {:?}, delay {})", 100.0 * err[c] / pk[c], pk[c], at[c], ff.delay);
+        eprintln!(
+            "h {h} m, time x{time_factor}, {} levels, component {c}: top misfit {:.2} % of peak accel {:.3} m/s² (at {:?}, delay {}); velocity {:.2} % of peak {:.4} m/s",
+            ff.levels(), 100.0 * ea[c] / pa[c], pa[c], at[c], ff.delay, 100.0 * ev[c] / pv[c], pv[c]
+        );
     }
-    for c in 0..3 {
-        assert!(err[c] < limit * pk[c], "component {c}: misfit {} of peak {}", err[c], pk[c]);
-    }
-}
-
-#[test]
-fn radiating_box_top_moves_with_the_free_field_record() {
-    radiating_box_top_check(0.10);
-}
-
-/// Issue 29's 5 % (see [`radiating_box_top_check`]): fails at 7.7 %, left open.
-#[test]
-#[ignore = "issue 29's 5 % not met: measured 7.7 % (docs/dam_physics.md §4)"]
-fn radiating_box_top_moves_with_the_free_field_record_within_5_percent() {
-    radiating_box_top_check(0.05);
+    TopMisfits { accel: std::array::from_fn(|c| ea[c] / pa[c]), vel: std::array::from_fn(|c| ev[c] / pv[c]) }
 }
 
 /// ½ vᵀ M v + ½ uᵀ K u of the run's state at t[n] [J].

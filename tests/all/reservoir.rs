@@ -444,6 +444,67 @@ fn acoustic_harmonic_wall_pressure_matches_chopras_rigid_dam_solution() {
     assert!((fe / exact - 1.0).abs() < 0.05, "resonance α 0.5: {fe} vs {exact}");
 }
 
+/// The run's water summary (`summary.json` → `water`) counts what it says: driven hard enough
+/// (the wall at 30 m/s², 0.5 f1, into h = 36 m of water: a suction of the order ρ a h ≈ 1 MPa,
+/// above the hydrostatic 353 kPa at the foot plus |p_v|), the cavitation floor holds unknowns;
+/// the reference is an independent count of the unknowns sitting exactly at their floor after
+/// each water step (one substep per step here), and the largest |p| seen. Exact (integers;
+/// the peak to 1e-12). Without `vapour_pressure` nothing is counted and the field goes below
+/// the floor.
+#[test]
+fn acoustic_water_summary_counts_cavitation_and_the_peak_pressure() {
+    let (h, c) = (36.0, 1440.0);
+    let f = 0.5 * c / (4.0 * h);
+    let loads = jointquake::dynamics::loads::Loads::default();
+    let mut below_floor = 0usize;
+    for pv in [None, Some(-99000.0)] {
+        let mut fluid = water_groups();
+        fluid.vapour_pressure = pv;
+        let (mesh, water) = acoustic_channel(h, 1.5, 3.0 * h, [36, 1, 12], &fluid);
+        // the floor of the dynamic pressure, p_v − ρ g (h − z), per unknown (the water's own
+        // with cavitation, after checking it against the formula)
+        let formula: Vec<f64> = water.fluid.nodes.iter().map(|&v| -99000.0 - 1000.0 * 9.81 * (h - mesh.nodes[v][2])).collect();
+        if let Some(fl) = &water.floor {
+            assert!(fl.iter().zip(&formula).all(|(a, b)| (a - b).abs() < 1e-9 * b.abs()));
+        }
+        let floor = water.floor.clone().unwrap_or(formula);
+        let dt = 0.9 * water.stable_step();
+        let mut run = AcousticRun::new(&water, &loads, false, dt);
+        assert_eq!(run.substeps, 1);
+        let nd = water.coupling.dam_nodes.len();
+        let (mut held, mut steps_with, mut most, mut peak, mut first) = (0u64, 0u64, 0usize, 0.0f64, None);
+        for k in 0..(2.0 / f / dt) as usize {
+            let t = k as f64 * dt;
+            run.advance_with_acceleration(&vec![[30.0 * (2.0 * PI * f * t).sin(), 0.0, 0.0]; nd], dt);
+            let at = run.p.iter().zip(&floor).filter(|(p, fl)| **p == **fl).count();
+            below_floor += run.p.iter().zip(&floor).filter(|(p, fl)| **p < **fl).count();
+            held += at as u64;
+            steps_with += (at > 0) as u64;
+            most = most.max(at);
+            if at > 0 && first.is_none() {
+                first = Some(t + dt);
+            }
+            peak = run.p.iter().fold(peak, |m, p| m.max(p.abs()));
+        }
+        let st = &run.stats;
+        println!("vapour pressure {pv:?}: {} unknown-steps held in {} steps (most {}), first {:?} s; peak {:.4e} Pa; {}", st.cavitated_node_steps, st.cavitated_steps, st.max_cavitated_nodes, st.first_cavitation_t, st.peak_pressure, st.line());
+        assert_eq!(st.cavitation, pv.is_some());
+        assert!((st.peak_pressure - peak).abs() <= 1e-12 * peak, "peak {} vs {peak}", st.peak_pressure);
+        assert!((st.dt_stable - water.stable_step()).abs() == 0.0 && st.substeps == 1 && st.dt == dt);
+        if pv.is_some() {
+            assert!(held > 0, "the wall's suction must reach the vapour pressure");
+            assert_eq!((st.cavitated_node_steps, st.cavitated_steps, st.max_cavitated_nodes), (held, steps_with, most));
+            let ft = st.first_cavitation_t.expect("cavitated");
+            assert!((ft - first.unwrap()).abs() < 1e-9 * ft, "first {ft} vs {first:?}");
+        } else {
+            assert_eq!((st.cavitated_node_steps, st.cavitated_steps, st.first_cavitation_t), (0, 0, None));
+            assert!(below_floor > 0, "without cavitation the same drive takes the water below the floor");
+            below_floor = 0;
+        }
+    }
+    assert_eq!(below_floor, 0, "with cavitation no unknown goes below its floor");
+}
+
 #[test]
 fn acoustic_far_end_absorbs_a_plane_pulse() {
     // Reference: Sommerfeld's condition ∂p/∂t = −c ∂p/∂n is exact for a plane wave at normal

@@ -59,6 +59,7 @@ use crate::mesh::Mesh;
 use crate::model::Model;
 use crate::scene::reservoir::FluidScene;
 use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
 
 /// Safety factor on the water's stable step when choosing its substeps: 0.9 (the Gershgorin
 /// bound is already an upper bound of ω_max; the margin covers the coupling with the dam).
@@ -164,17 +165,26 @@ impl AcousticWater {
     }
 
     /// One water step of `h` from (p⁻, p) to p⁺ with the flux `q` (module doc); `hp` scratch.
-    pub fn advance_into(&self, p_prev: &[f64], p: &[f64], q: &[f64], h: f64, hp: &mut [f64], p_next: &mut [f64]) {
+    /// Returns how many unknowns the cavitation floor holds after the step (at or below it; 0
+    /// without cavitation).
+    pub fn advance_into(&self, p_prev: &[f64], p: &[f64], q: &[f64], h: f64, hp: &mut [f64], p_next: &mut [f64]) -> usize {
         self.fluid.laplacian.mul_into(p, hp);
         let h2 = h * h;
+        let mut floored = 0;
         for k in 0..p.len() {
             let (m, c) = (self.capacity[k] / h2, self.damping[k] / (2.0 * h));
             let mut v = (m * (2.0 * p[k] - p_prev[k]) + c * p_prev[k] - hp[k] + q[k]) / (m + c);
-            if let Some(fl) = &self.floor {
-                v = v.max(fl[k]);
+            // at or below the floor: held there (a cavitated region stays at the floor exactly
+            // when its neighbours do, the Laplacian of the floor's linear profile being zero)
+            if let Some(fl) = &self.floor
+                && v <= fl[k]
+            {
+                v = fl[k];
+                floored += 1;
             }
             p_next[k] = v;
         }
+        floored
     }
 
     /// The discrete energy of the water's pressure field, ½ v·Q v + ½ p·H p⁻ with v = (p − p⁻)/h
@@ -236,6 +246,50 @@ fn add_boundary_damping(mesh: &Mesh, water: &FluidMesh, groups: &[String], coef:
     Ok(area)
 }
 
+/// The acoustic water of a run in `summary.json` (`water`): the water's step beside the solid's,
+/// the largest dynamic pressure and, with cavitation, how much of the water the floor held.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct WaterSummary {
+    /// Pressure unknowns (nodes off the free surface).
+    pub unknowns: usize,
+    /// The water's stable step 2/ω_max (Gershgorin) [s], beside the run's `dt_stable`.
+    pub dt_stable: f64,
+    /// Water steps per solid step, and their length dt / substeps [s].
+    pub substeps: usize,
+    pub dt: f64,
+    /// The largest |dynamic pressure| of any unknown over the dynamic stage [Pa], where and when
+    /// (the water node's index in the mesh, the time [s]).
+    pub peak_pressure: f64,
+    pub peak_node: usize,
+    pub peak_t: f64,
+    /// With cavitation (`fluid.vapour_pressure`): whether it was on, the unknown-steps held at
+    /// the floor (summed over the water's substeps), the solid steps with any, the largest number
+    /// of unknowns held in one water step and the first time [s] (null: never).
+    pub cavitation: bool,
+    pub cavitated_node_steps: u64,
+    pub cavitated_steps: u64,
+    pub max_cavitated_nodes: usize,
+    pub first_cavitation_t: Option<f64>,
+}
+
+impl WaterSummary {
+    /// One line for the run's summary text.
+    pub fn line(&self) -> String {
+        let cav = match (self.cavitation, self.first_cavitation_t) {
+            (false, _) => "cavitation off".to_string(),
+            (true, None) => "cavitation on, never reached".to_string(),
+            (true, Some(t)) => format!(
+                "cavitation: {} unknown-steps held at the vapour pressure in {} solid steps (at most {} unknowns at once), first at t = {t:.4} s",
+                self.cavitated_node_steps, self.cavitated_steps, self.max_cavitated_nodes
+            ),
+        };
+        format!(
+            "acoustic, {} unknowns: step {:.4e} s ({} per solid step; the water's stable {:.4e} s); peak dynamic pressure {:.4e} Pa (t = {:.4} s, node {}); {cav}",
+            self.unknowns, self.dt, self.substeps, self.dt_stable, self.peak_pressure, self.peak_t, self.peak_node
+        )
+    }
+}
+
 /// The acoustic water in a run: its state (p[n], p[n−1]), scratch, and the hook into the solid
 /// step (module doc).
 pub struct AcousticRun<'p> {
@@ -254,6 +308,10 @@ pub struct AcousticRun<'p> {
     next: Vec<f64>,
     accel: Vec<[f64; 3]>,
     dynamic: bool,
+    /// The water's clock [s]: the time of p[n] (0 at rest, at the start of the dynamic stage).
+    pub t: f64,
+    /// What the run's summary reports (`WaterSummary`: peaks and cavitation counts).
+    pub stats: WaterSummary,
 }
 
 impl<'p> AcousticRun<'p> {
@@ -272,25 +330,52 @@ impl<'p> AcousticRun<'p> {
             next: vec![0.0; n],
             accel: vec![[0.0; 3]; water.coupling.dam_nodes.len()],
             dynamic: false,
+            t: 0.0,
+            stats: Self::fresh_stats(water, dt),
         }
     }
 
-    /// The water at rest (p = 0: the hydrostatic state), as at the start of the dynamic stage.
+    fn fresh_stats(water: &AcousticWater, dt: f64) -> WaterSummary {
+        let substeps = water.substeps(dt);
+        WaterSummary { unknowns: water.fluid.nodes.len(), dt_stable: water.stable_step(), substeps, dt: dt / substeps as f64, cavitation: water.floor.is_some(), ..WaterSummary::default() }
+    }
+
+    /// The water at rest (p = 0: the hydrostatic state), as at the start of the dynamic stage;
+    /// its peaks and cavitation counts restart too.
     pub fn restart(&mut self) {
         self.p.fill(0.0);
         self.p_prev.fill(0.0);
+        self.t = 0.0;
+        self.stats = Self::fresh_stats(self.water, self.stats.dt * self.substeps as f64);
     }
 
     /// Advance the water over one solid step `dt` with the dam's total accelerations `a` [m/s²]
-    /// at the coupling's dam nodes, held over the substeps.
+    /// at the coupling's dam nodes, held over the substeps; the water's clock, its peak pressure
+    /// and the cavitation counts follow.
     pub fn advance_with_acceleration(&mut self, a: &[[f64; 3]], dt: f64) {
+        let t = self.t;
+        self.t += dt;
         self.water.flux_into(a, &mut self.q);
         let h = dt / self.substeps as f64;
-        for _ in 0..self.substeps {
-            self.water.advance_into(&self.p_prev, &self.p, &self.q, h, &mut self.hp, &mut self.next);
+        let mut any = false;
+        for s in 0..self.substeps {
+            let held = self.water.advance_into(&self.p_prev, &self.p, &self.q, h, &mut self.hp, &mut self.next);
             std::mem::swap(&mut self.p_prev, &mut self.p);
             std::mem::swap(&mut self.p, &mut self.next);
+            let st = &mut self.stats;
+            if held > 0 {
+                any = true;
+                st.cavitated_node_steps += held as u64;
+                st.max_cavitated_nodes = st.max_cavitated_nodes.max(held);
+                st.first_cavitation_t.get_or_insert(t + (s + 1) as f64 * h);
+            }
+            for (k, &v) in self.p.iter().enumerate() {
+                if v.abs() > st.peak_pressure {
+                    (st.peak_pressure, st.peak_node, st.peak_t) = (v.abs(), self.water.fluid.nodes[k], t + (s + 1) as f64 * h);
+                }
+            }
         }
+        self.stats.cavitated_steps += any as u64;
     }
 
     /// The water's field energy now (see [`AcousticWater::field_energy`]) for solid steps `dt`.
