@@ -634,7 +634,7 @@ fn objective_stress_section(r: &DamReport, doc: &mut Doc) {
     let _ = writeln!(md, "\n## Face stresses outside the band at the rock, and the area above a tension\n");
     let _ = writeln!(
         md,
-        "The raw element peaks above sit in the elements along the dam–rock contact and the abutments' re-entrant corners, where the elastic stress is singular and grows under refinement. Here the faces whose centre is within {} m of the face's contact line with the rock (its boundary except the crest: `FaceEnvelope::objective`, src/output/envelope.rs) are left out; and, as USACE EM 1110-2-6053 plots demand against capacity, the area of each face whose largest σ1 exceeded {} MPa (`FaceEnvelope::area_above`).\n",
+        "The raw element peaks above sit in the elements along the dam–rock contact and the abutments' re-entrant corners, where the elastic stress is singular and grows under refinement. Here the faces whose centre is within {} m of the face's contact line with the rock (its boundary except the crest and the joints' traces: `FaceEnvelope::objective`, src/output/envelope.rs) are left out; and, as USACE EM 1110-2-6053 plots demand against capacity, the area of each face whose largest σ1 exceeded {} MPa (`FaceEnvelope::area_above`).\n",
         fmt_sig(OBJECTIVE_BAND, 3),
         TENSION_THRESHOLDS.map(|t| fmt_sig(t * 1e-6, 2)).join(", ")
     );
