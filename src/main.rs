@@ -504,6 +504,16 @@ enum StudyCmd {
     /// Read every run and step, write `<out>/report.md`, `report.json` and `charts/`. Exits
     /// with status 1 (after writing) when runs or steps have no results, naming them.
     Report { study: PathBuf },
+    /// A dam study's extrapolated reference (docs/dam.md, "Convergence"): per quantity, method
+    /// and level the values on each mesh, the observed order, the extrapolated value and its
+    /// error band, the meshes and the runs' commits, as JSON (the `report.reference` of
+    /// pipelines/dam_study.json reads it).
+    Extrapolate {
+        study: PathBuf,
+        /// The JSON to write.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Charts of one run of the study's model in `<run>/charts/` (the wedge: slip at P2 with
     /// the rigid block, P1 displacement).
     Chart {
@@ -986,6 +996,12 @@ fn study_cmd(action: StudyCmd) -> Result<()> {
                 let list = r.problems.iter().map(|(id, why)| format!("  {id}: {why}")).collect::<Vec<_>>().join("\n");
                 anyhow::bail!("the report is written, but {} run(s) or step(s) have no results (listed in it); `make -f {} all` runs them:\n{list}", r.problems.len(), s.out.join("runs.mk").display());
             }
+        }
+        StudyCmd::Extrapolate { study: path, out } => {
+            let s = jointquake::study::Study::load(&path).with_context(|| format!("loading study {}", path.display()))?;
+            let kind = jointquake::studies::dam::DamKind::new(&s).with_context(|| format!("study {} (must be of kind \"dam\")", path.display()))?;
+            let r = jointquake::studies::dam::reference::extrapolate(&s, &kind, &out).with_context(|| format!("extrapolating study {}", path.display()))?;
+            say!("study {} reference: {} ({} values; meshes {}; {})", s.name, out.display(), r.values.len(), r.meshes.iter().map(|m| m.label.as_str()).collect::<Vec<_>>().join(", "), r.note);
         }
         StudyCmd::Chart { study: path, scene, run } => {
             let (s, kind) = load(&path)?;

@@ -74,6 +74,133 @@ impl FaceEnvelope {
     }
 }
 
+/// Width of the band along a face's contact with the rock excluded from the mesh-objective
+/// stress [m]: 20 m. Why: the raw element peak sits in the elements touching the dam–rock
+/// contact and the abutments' re-entrant corners, where the elastic stress is singular and grows
+/// under refinement (docs/dam.md, "Convergence"); 20 m is two crest thicknesses (Tc 10 m) and
+/// one element of the coarsest study mesh (h 20 m), so on every mesh of the study the elements
+/// along the contact line are out and the same physical region is kept.
+pub const OBJECTIVE_BAND: f64 = 20.0;
+
+/// A boundary edge whose midpoint is within this fraction of its length of another boundary
+/// edge is along a joint, not on the rock (dimensionless): 0.1. Why: on the rock the next edge
+/// of the contact line starts at the edge's end, (L/2)·sin θ ≥ 0.1 L away from its midpoint for
+/// any turn of the line sharper than θ = 11.5° back on itself; across a joint of mismatched
+/// meshes the other side's chord of the same trace is at most the difference of the two
+/// sagittas away, L²/(8R) = 0.05 L for L = 20 m on the 50 m radius of the tightest curve of
+/// the dam's faces.
+pub const JOINT_EDGE_TOLERANCE: f64 = 0.1;
+
+/// The face stress outside a band along the face's contact with the rock (the mesh-objective
+/// measure of [`FaceEnvelope::objective`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ObjectiveStress {
+    /// The excluded band's width [m] (distance of a face's centre to the contact line).
+    pub band: f64,
+    /// Largest σ1 [Pa] over the kept faces and the centre of its face [m].
+    pub max_tension: f64,
+    pub max_tension_at: [f64; 3],
+    /// Smallest σ3 [Pa] over the kept faces and the centre of its face [m].
+    pub max_compression: f64,
+    pub max_compression_at: [f64; 3],
+    /// Faces kept and excluded.
+    pub kept: usize,
+    pub excluded: usize,
+}
+
+impl FaceEnvelope {
+    /// The centre of face `i` [m] (mean of its corners).
+    pub fn centre(&self, i: usize) -> [f64; 3] {
+        let c = &self.corners[i];
+        let n = c.len().max(1) as f64;
+        let mut x = [0.0; 3];
+        for p in c {
+            for k in 0..3 {
+                x[k] += p[k] / n;
+            }
+        }
+        x
+    }
+
+    /// The face group's contact line with the rock: its boundary edges (an edge of exactly one
+    /// face, corners matched by position to 1 mm) except those along a joint and those on the
+    /// crest (both ends within 1 mm of the highest z of the group). An edge is along a joint when
+    /// another boundary edge passes within [`JOINT_EDGE_TOLERANCE`] × its length of its midpoint:
+    /// the two sides of a joint of mismatched meshes (the dam's odd and even monoliths) have
+    /// different edges along the same trace. For a dam face: the foundation line and the
+    /// abutments.
+    pub fn contact_edges(&self) -> Vec<[[f64; 3]; 2]> {
+        use std::collections::HashMap;
+        let key = |p: &[f64; 3]| p.map(|x| (x * 1e3).round() as i64);
+        let mut count: HashMap<([i64; 3], [i64; 3]), ([f64; 3], [f64; 3], usize)> = HashMap::new();
+        for c in &self.corners {
+            for k in 0..c.len() {
+                let (a, b) = (c[k], c[(k + 1) % c.len()]);
+                let (ka, kb) = (key(&a), key(&b));
+                let e = count.entry(if ka < kb { (ka, kb) } else { (kb, ka) }).or_insert((a, b, 0));
+                e.2 += 1;
+            }
+        }
+        let top = self.corners.iter().flatten().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max);
+        let boundary: Vec<[[f64; 3]; 2]> = count
+            .into_values()
+            .filter(|(a, b, n)| *n == 1 && !(a[2] >= top - 1e-3 && b[2] >= top - 1e-3))
+            .map(|(a, b, _)| [a, b])
+            .collect();
+        let along_joint = |i: usize| {
+            let [a, b] = boundary[i];
+            let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])];
+            let tol = JOINT_EDGE_TOLERANCE * segment_distance(a, b, b);
+            boundary.iter().enumerate().any(|(k, f)| k != i && segment_distance(m, f[0], f[1]) < tol)
+        };
+        let mut edges: Vec<[[f64; 3]; 2]> = (0..boundary.len()).filter(|&i| !along_joint(i)).map(|i| boundary[i]).collect();
+        edges.sort_by(|x, y| x[0].partial_cmp(&y[0]).unwrap_or(std::cmp::Ordering::Equal));
+        edges
+    }
+
+    /// Which faces are within `band` [m] of the contact line ([`Self::contact_edges`]): the
+    /// distance of the face's centre to the nearest edge segment.
+    pub fn in_band(&self, band: f64) -> Vec<bool> {
+        let edges = self.contact_edges();
+        (0..self.corners.len())
+            .map(|i| {
+                let x = self.centre(i);
+                edges.iter().any(|e| segment_distance(x, e[0], e[1]) <= band)
+            })
+            .collect()
+    }
+
+    /// The mesh-objective face stress: the envelope's σ1 and σ3 over the faces outside `band`
+    /// [m] of the contact with the rock. `None` without corners (files written before them) or
+    /// when every face is in the band.
+    pub fn objective(&self, band: f64) -> Option<ObjectiveStress> {
+        if self.corners.len() != self.elements.len() || self.corners.is_empty() {
+            return None;
+        }
+        let out = self.in_band(band);
+        let kept: Vec<usize> = (0..out.len()).filter(|&i| !out[i]).collect();
+        let t = *kept.iter().max_by(|&&a, &&b| self.max_principal[a].total_cmp(&self.max_principal[b]))?;
+        let c = *kept.iter().min_by(|&&a, &&b| self.min_principal[a].total_cmp(&self.min_principal[b]))?;
+        Some(ObjectiveStress {
+            band,
+            max_tension: self.max_principal[t],
+            max_tension_at: self.centre(t),
+            max_compression: self.min_principal[c],
+            max_compression_at: self.centre(c),
+            kept: kept.len(),
+            excluded: out.len() - kept.len(),
+        })
+    }
+}
+
+/// Distance from point `x` to segment `a`–`b` [m].
+fn segment_distance(x: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let v = |p: [f64; 3]| nalgebra::Vector3::from(p);
+    let (ab, ax) = (v(b) - v(a), v(x) - v(a));
+    let s = if ab.norm_squared() > 0.0 { (ax.dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0) } else { 0.0 };
+    (ax - s * ab).norm()
+}
+
 /// Area of a tri3 or quad4 face with corner points `x` (see [`FaceEnvelope::areas`]).
 fn face_area(x: &[[f64; 3]]) -> f64 {
     let v = |p: [f64; 3]| nalgebra::Vector3::from(p);
@@ -375,5 +502,44 @@ mod tests {
         };
         let got: Vec<f64> = TENSION_THRESHOLDS.iter().map(|&t| f.area_above(t)).collect();
         assert_eq!(got, vec![5.0, 3.0, 3.0]);
+    }
+
+    #[test]
+    fn the_objective_band_excludes_exactly_the_faces_near_the_rock_and_keeps_the_crest() {
+        // A 50 × 30 m face in the xz-plane, crest at z = 30, rock along z = 0, x = 0 and x = 50
+        // (each square has its own corners, as across a joint). Distance of a face centre to the
+        // contact line: min(z, x, 50 − x) (the crest and the joints are not contact), so a 12 m
+        // band keeps exactly the centres with 12 < x < 38 and z > 12: x 15, 35 at z 15, 25 and
+        // x 25 at z 12.5 … 27.5; the 50 MPa in the corner face is out, the 7 MPa at (25, 22.5)
+        // is the objective peak, the −9 MPa at (35, 15) its σ3.
+        let mut f = FaceEnvelope { group: "g".into(), elements: vec![], max_principal: vec![], min_principal: vec![], max_tension: Extreme::default(), max_compression: Extreme::default(), corners: vec![], areas: vec![] };
+        // the middle column (x 20–30) is a monolith meshed finer, squares of 5 m: its joints
+        // with its neighbours are mismatched (edges of 5 m against 10 m), not contact
+        for i in 0..5 {
+            let (n, d) = if i == 2 { (6, 5.0) } else { (3, 10.0) };
+            for k in 0..n {
+                let (x, z) = (10.0 * i as f64, d * k as f64);
+                f.corners.push(vec![[x, 0.0, z], [x + 10.0, 0.0, z], [x + 10.0, 0.0, z + d], [x, 0.0, z + d]]);
+                f.elements.push(f.elements.len());
+                f.areas.push(10.0 * d);
+                let s1 = match (i, k) { (0, 0) => 50e6, (2, 4) => 7e6, _ => 1e6 };
+                let s3 = match (i, k) { (4, 0) => -40e6, (3, 1) => -9e6, _ => -1e6 };
+                f.max_principal.push(s1);
+                f.min_principal.push(s3);
+            }
+        }
+        // the base (5 edges), the two sides (3 + 3); not the joints, not the crest
+        assert_eq!(f.contact_edges().len(), 5 + 3 + 3);
+        let band = f.in_band(12.0);
+        let kept: Vec<[f64; 3]> = (0..f.elements.len()).filter(|&i| !band[i]).map(|i| f.centre(i)).collect();
+        let want: Vec<[f64; 3]> = vec![[15.0, 0.0, 15.0], [15.0, 0.0, 25.0], [25.0, 0.0, 12.5], [25.0, 0.0, 17.5], [25.0, 0.0, 22.5], [25.0, 0.0, 27.5], [35.0, 0.0, 15.0], [35.0, 0.0, 25.0]];
+        assert_eq!(kept, want);
+        let o = f.objective(12.0).unwrap();
+        assert_eq!((o.max_tension, o.max_tension_at, o.max_compression, o.max_compression_at, o.kept, o.excluded), (7e6, [25.0, 0.0, 22.5], -9e6, [35.0, 0.0, 15.0], 8, 10));
+        // area above 3 MPa: the 50 MPa (100 m²) and 7 MPa (50 m²) faces, 150 m² (hand sum);
+        // above 10 MPa: the first only
+        assert_eq!((f.area_above(3e6), f.area_above(10e6)), (150.0, 100.0));
+        // a band wider than the face keeps nothing
+        assert_eq!(f.objective(30.0), None);
     }
 }
