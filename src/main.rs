@@ -209,6 +209,9 @@ struct TestcaseArgs {
     /// Patch: the lower block massless (condensed).
     #[arg(long)]
     massless_lower: bool,
+    /// Patch: load path p first (relaxed), then τ at full p (default: p and τ together).
+    #[arg(long)]
+    pressure_first: bool,
     /// Slide: simulated time [s].
     #[arg(long)]
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -1388,7 +1388,7 @@ impl ContactSolver<'_> {
     /// The Gauss–Seidel sweeps over the active pairs; returns the sweeps made and whether they
     /// reached `gs_tolerance`.
     #[inline(never)]
-    fn sweep_into(&mut self, u_next: &mut [f64]) -> (usize, bool, f64) {
+    fn sweep_into(&mut self, u_next: &mut [f64]) -> (usize, bool, f64, Option<u32>) {
         let mut clock = 1u32;
         // A node moved by less than 1 % of the tolerance does not call its pairs back: their
         // forces would change by a fraction of that (the fixed point is the same to within the
@@ -1414,8 +1414,14 @@ impl ContactSolver<'_> {
         let mut moving = pairs;
         let mut residual = 0.0;
         let m = mortar;
+        // the positions before the last sweep allowed (only in a step that reaches it): which
+        // node that sweep moved most, for the warning (`CapStep`)
+        let mut before_last: Vec<Vector3<f64>> = Vec::new();
         while !converged && sweeps < *gs_max_sweeps {
             sweeps += 1;
+            if sweeps == *gs_max_sweeps {
+                before_last.extend(local.iter().map(|l| l.x));
+            }
             if !listed && 2 * moving < pairs {
                 listed = true;
                 clock += 1;
@@ -1433,6 +1439,7 @@ impl ContactSolver<'_> {
             converged = max_du <= *gs_tolerance
                 || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e)) && !m.active.iter().zip(m.evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
         }
+        let worst = (!converged && !before_last.is_empty()).then(|| local.iter().zip(&before_last).enumerate().map(|(k, (l, b))| (k as u32, (l.x - b).norm_squared())).fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a }).0);
         // the corrected displacements back into the prediction
         for (l, &nd) in local.iter().zip(local_global.iter()) {
             let v = &mut u_next[3 * nd as usize..3 * nd as usize + 3];
@@ -1440,20 +1447,24 @@ impl ContactSolver<'_> {
             v[1] = l.x[1];
             v[2] = l.x[2];
         }
-        (sweeps, converged, residual)
+        (sweeps, converged, residual, worst)
     }
 
     /// Write the active pairs' results into the history and return the contact work of the
     /// step [J].
     #[inline(never)]
-    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, residual: f64, u_prev: &[f64]) -> f64 {
+    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, residual: f64, u_prev: &[f64], worst: Option<(u32, f64)>) -> f64 {
         let mut work = 0.0;
+        let cap = worst.filter(|_| !converged && history.joints.iter().any(|r| residual > r.max_gs_residual)).map(|(k, t)| self.cap_step(k, t, residual));
         for rec in history.joints.iter_mut() {
             rec.sweeps = sweeps;
             rec.gs_residual = residual;
             rec.max_sweeps = rec.max_sweeps.max(sweeps);
             if !converged {
                 rec.unconverged_steps += 1;
+                if residual > rec.max_gs_residual {
+                    rec.worst_cap = cap.clone();
+                }
                 rec.max_gs_residual = rec.max_gs_residual.max(residual);
             }
         }
@@ -1464,6 +1475,16 @@ impl ContactSolver<'_> {
             work += record_pair_into(a, history, &self.local, u_prev);
         }
         work
+    }
+
+    /// The step at t `t` stopped at the sweep budget: local node `k` moved most in its last
+    /// sweep (by `residual`); its global node and the active pairs on it (`CapStep`).
+    fn cap_step(&self, k: u32, t: f64, residual: f64) -> crate::contact::state::CapStep {
+        let on = |span: usize, local: &[u32], joint: u32, slave: u32, state: PairState| local[..span].contains(&k).then_some((joint as usize, slave as usize, state));
+        let mut pairs: Vec<(usize, usize, PairState)> = self.active.iter().filter_map(|a| on(a.span(), &a.local, a.joint, a.nodes[0], a.state)).collect();
+        pairs.extend(self.mortar.active.iter().filter_map(|a| on(a.span(), &a.local, a.joint, a.nodes[0], a.state)));
+        pairs.sort_by_key(|p| (p.0, p.1));
+        crate::contact::state::CapStep { t, node: self.local_global[k as usize] as usize, residual, pairs }
     }
 }
 
@@ -1535,9 +1556,9 @@ impl Constraint<ContactState> for ContactSolver<'_> {
         let t_prepare = now_if(timed);
         self.prepare_sweeps_into(u_next);
         let t_sweeps = now_if(timed);
-        let (sweeps, converged, residual) = self.sweep_into(u_next);
+        let (sweeps, converged, residual, worst) = self.sweep_into(u_next);
         let t_record = now_if(timed);
-        let work = penalty_work + self.record_into(history, sweeps, converged, residual, u_prev);
+        let work = penalty_work + self.record_into(history, sweeps, converged, residual, u_prev, worst.map(|k| (k, step.t_next)));
         if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {
             t.search += b - a;
             t.prepare += c - b;

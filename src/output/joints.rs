@@ -61,6 +61,9 @@ pub struct JointPeaks {
     /// stopped at the sweep budget; 0 when every step converged).
     #[serde(default)]
     pub max_gs_residual: f64,
+    /// The step behind `max_gs_residual`: when, which node, the pairs on it (warning).
+    #[serde(default)]
+    pub worst_cap: Option<crate::contact::state::CapStep>,
     /// Typical slave face size √(slave area / faces) [m] (the scale of the NTN warning).
     #[serde(default)]
     pub face_size: f64,
@@ -245,6 +248,7 @@ impl JointWriter {
             pk.max_sweeps = r.max_sweeps;
             pk.unconverged_steps = r.unconverged_steps;
             pk.max_gs_residual = pk.max_gs_residual.max(r.max_gs_residual);
+            pk.worst_cap.clone_from(&r.worst_cap);
             pk.events = r.events.clone();
             pk.max_lost_travel = pk.max_lost_travel.max(ml);
             let c = state_counts(r);

@@ -409,6 +409,8 @@ impl Recorder {
         let steps = self.stop.unwrap_or(sim.n_steps()).max(1) as f64;
         // (steps, residual, tolerance, joints) of the Gauss–Seidel warnings
         let mut gs: Vec<(u64, f64, f64, Vec<String>)> = Vec::new();
+        let mut worst_cap = None;
+        let joint_names: Vec<&str> = sim.problem.joints.iter().map(|j| j.tag.name.as_str()).collect();
         for (pk, j) in jw.peaks.iter().zip(&sim.problem.joints) {
             let node_steps = pk.slave_nodes.max(1) as f64 * steps;
             // lost inside the master's outline (not beyond its free edge: `lost_notes`)
@@ -426,6 +428,7 @@ impl Recorder {
                 // the joints' pairs are swept together, so joints sharing the sweeps report the
                 // same numbers: one warning for them all (a dam's 28 joints gave 28 equal lines)
                 let (steps, residual, tolerance) = (pk.unconverged_steps, pk.max_gs_residual, pk.gs_tolerance);
+                worst_cap = worst_cap.or(pk.worst_cap.as_ref());
                 match gs.iter_mut().find(|g| (g.0, g.1, g.2) == (steps, residual, tolerance)) {
                     Some(g) => g.3.push(pk.name.clone()),
                     None => gs.push((steps, residual, tolerance, vec![pk.name.clone()])),
@@ -440,8 +443,9 @@ impl Recorder {
         }
         for (steps, residual, tolerance, names) in gs {
             let who = if names.len() == 1 { format!("joint {}", names[0]) } else { format!("joints {} ({} joints, swept together)", names.join(", "), names.len()) };
+            let worst = worst_cap.map(|c| format!("; {}", c.describe(&joint_names))).unwrap_or_default();
             w.push(format!(
-                "{who}: Gauss–Seidel stopped at gs_max_sweeps in {steps} steps with a residual up to {residual:.2e} m, {:.0} × its tolerance {tolerance:.1e} m (above {GS_WARN_FACTOR}×): the contact forces of those steps are not converged (cap: ContactSolver::gs_max_sweeps, 200 sweeps)",
+                "{who}: Gauss–Seidel stopped at gs_max_sweeps in {steps} steps with a residual up to {residual:.2e} m, {:.0} × its tolerance {tolerance:.1e} m (above {GS_WARN_FACTOR}×): the contact forces of those steps are not converged (cap: ContactSolver::gs_max_sweeps, 200 sweeps){worst}",
                 residual / tolerance
             ));
         }

@@ -90,10 +90,42 @@ fn variant(s: &crate::testcase::Resolved) -> String {
     if s.massless_lower {
         v.push("massless lower".into());
     }
+    if s.pressure_first {
+        v.push("p first, then τ".into());
+    }
     if let Some(e) = s.edge_tolerance {
         v.push(format!("edge_tolerance {e}"));
     }
     if v.is_empty() { "flat".into() } else { v.join(", ") }
+}
+
+/// The methods compared on the same case: the cases grouped by everything but the method
+/// (kind, sides, slave, tie, loads and joint variant), a group shown when it has two methods or
+/// more, the headline error of each method in its column.
+fn side_by_side(done: &[(String, CaseResult)]) -> Result<Table, Error> {
+    use crate::scene::ContactMethod;
+    const METHODS: [ContactMethod; 4] = [ContactMethod::Nts, ContactMethod::Ntn, ContactMethod::Penalty, ContactMethod::Mortar];
+    let lower = |d: String| d.to_lowercase();
+    let key = |s: &crate::testcase::Resolved| format!("{} {} / {}, slave {}{}, {}", lower(format!("{:?}", s.kind)), s.lower, s.upper, lower(format!("{:?}", s.slave)), if s.tied { ", tied" } else { "" }, variant(s));
+    let mut groups: Vec<(String, &CaseResult, [Option<f64>; 4])> = Vec::new();
+    for (_, r) in done {
+        let k = key(&r.spec);
+        let Some(m) = METHODS.iter().position(|&m| m == r.spec.method) else { continue };
+        match groups.iter_mut().find(|g| g.0 == k) {
+            Some(g) => g.2[m] = g.2[m].or(Some(r.error)),
+            None => {
+                let mut e = [None; 4];
+                e[m] = Some(r.error);
+                groups.push((k, r, e));
+            }
+        }
+    }
+    let mut table = Table::new(["case", "h_s/h_m", "error of", "NTS", "NTN", "penalty", "mortar"]);
+    let cell = |e: Option<f64>| e.map_or_else(|| "–".to_string(), |x| format!("{} %", fmt_sig(100.0 * x, 3)));
+    for (k, r, e) in groups.iter().filter(|g| g.2.iter().flatten().count() >= 2) {
+        table.push_row([k.clone(), fmt_sig(r.mesh_ratio, 3), r.error_of.clone(), cell(e[0]), cell(e[1]), cell(e[2]), cell(e[3])])?;
+    }
+    Ok(table)
 }
 
 fn step_name(id: &str) -> String {
@@ -175,9 +207,11 @@ impl StudyKind for JointTestsKind {
             ])?;
         }
         md.push_str(&table.to_markdown());
+        let _ = writeln!(md, "\n## The methods side by side\n\nThe cases above that differ only in the contact method (same meshes, slave side, tie, loads and joint), one row each: the headline error of each method (– where the study has no such line).\n");
+        md.push_str(&side_by_side(&done)?.to_markdown());
         let _ = writeln!(
             md,
-            "\n**Published behaviour for comparison (not run here).** CalculiX: the ccx manual asks for a slave side of node-to-face penalty contact at least as fine as the master (ccx 2.7 manual, \"Node-to-face penalty contact\", http://web.mit.edu/calculix_v2.7/CalculiX/ccx_2.7/doc/ccx/node111.html) and says its face-to-face penalty contact, integrated over the triangulated overlaps of slave and master faces, \"usually leads to a very smooth pressure distribution\" whichever side is slave (ccx 2.11 manual, \"Face-to-face penalty contact\"). The figure quoted by issue 20, node-to-face missing σzz by 34 % on the 4×4-over-3×3 hex8 patch test with face-to-face exact, could not be traced to a published source (manual, ccx test examples, CalculiX issue tracker; docs/validation.md §8): it is plotted as the issue's figure. A mortar-type option here would be measured against the NTS rows above.\n"
+            "\n**Published behaviour for comparison (not run here).** CalculiX: the ccx manual asks for a slave side of node-to-face penalty contact at least as fine as the master (ccx 2.7 manual, \"Node-to-face penalty contact\", http://web.mit.edu/calculix_v2.7/CalculiX/ccx_2.7/doc/ccx/node111.html) and says its face-to-face penalty contact, integrated over the triangulated overlaps of slave and master faces, \"usually leads to a very smooth pressure distribution\" whichever side is slave (ccx 2.11 manual, \"Face-to-face penalty contact\"). The figure quoted by issue 20, node-to-face missing σzz by 34 % on the 4×4-over-3×3 hex8 patch test with face-to-face exact, could not be traced to a published source (manual, ccx test examples, CalculiX issue tracker; docs/validation.md §8): it is plotted as the issue's figure; the segment-to-segment option here is the mortar column of the table above.\n"
         );
         // chart: patch pressure cases, headline error against mesh ratio, one series per method
         let mut chart = Chart::new("Patch test: σzz error next to the joint against mesh ratio", "h_slave / h_master", "largest |σzz/(−p) − 1| (cylinders: any σ component, / p) [%]");

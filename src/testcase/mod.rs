@@ -205,6 +205,16 @@ pub struct CaseSpec {
     /// layer touching the joint keeps its mass, docs/dam_physics.md). Default false.
     #[serde(default)]
     pub massless_lower: bool,
+    /// Patch: the load path. false (default): p and τ ramped in together from zero (over
+    /// `dynamics::RELAXATION_RAMP_STEPS` steps of the static solve); true: p first, relaxed to
+    /// equilibrium, then τ ramped in over as many steps at full p and relaxed again — the path
+    /// of a joint closed by its overburden before it is sheared. On the proportional path a
+    /// frictional joint's pairs carry shear at nearly no pressure in the first steps and some
+    /// slip (1.5e-4 of σ on hex 4/3 with mortar, μ = 0.6, τ = 0.3 p); on this one a joint with
+    /// |τ| < μ p sticks throughout ([`run`]). Needs p > 0 and τ ≠ 0. Only the in-memory static
+    /// solve (`--run`, the studies) takes it; the written scene keeps the proportional ramp.
+    #[serde(default)]
+    pub pressure_first: bool,
     /// Slide: simulated time [s]. Default 1 (1.18 m at β = 30°, μ = 0.3: 2.4 base elements of
     /// 0.5 m). Impact: ignored (3 L/c).
     #[serde(default)]
@@ -284,6 +294,9 @@ pub struct Resolved {
     pub shear: f64,
     pub inclination: f64,
     pub massless_lower: bool,
+    /// Patch: p relaxed first, then τ (see [`CaseSpec`]).
+    #[serde(default)]
+    pub pressure_first: bool,
     pub duration: f64,
     pub residual: f64,
     pub edge_tolerance: Option<f64>,
@@ -355,8 +368,11 @@ impl CaseSpec {
         }
         let pressure = self.pressure.unwrap_or(1e6);
         let shear = self.shear.unwrap_or(0.0);
-        if k != Kind::Patch && (self.pressure.is_some() || self.shear.is_some() || self.massless_lower || self.residual.is_some()) {
-            return Err(invalid("pressure/shear/massless_lower/residual", "only the patch kind takes these"));
+        if k != Kind::Patch && (self.pressure.is_some() || self.shear.is_some() || self.massless_lower || self.residual.is_some() || self.pressure_first) {
+            return Err(invalid("pressure/shear/massless_lower/residual/pressure_first", "only the patch kind takes these"));
+        }
+        if self.pressure_first && (pressure <= 0.0 || shear == 0.0) {
+            return Err(invalid("pressure_first", format!("p = {pressure}, τ = {shear}: the pressure-first path needs p > 0 and τ ≠ 0 (without shear the two paths are one)")));
         }
         if !(pressure.is_finite() && shear.is_finite()) || (pressure == 0.0 && shear == 0.0) || pressure < 0.0 {
             return Err(invalid("pressure", format!("p = {pressure}, τ = {shear}: give p ≥ 0 (compression) and τ, not both 0")));
@@ -419,7 +435,7 @@ impl CaseSpec {
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
-        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, record, pga })
+        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, pressure_first: self.pressure_first, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, record, pga })
     }
 
     /// The cylindrical joint (`curvature` R), if any: a patch case, |R| above the joint's
@@ -501,6 +517,9 @@ impl Resolved {
         }
         if let Some(rc) = self.curvature {
             l += &format!(" cylinder R {rc}");
+        }
+        if self.pressure_first {
+            l += " pressure first";
         }
         l
     }

@@ -6,7 +6,9 @@
 //!   mode is critically damped without a damping chosen by hand). The patch tractions are
 //!   handed to it as static forces (the loads relaxation applies with gravity), ramped in over
 //!   `RELAXATION_RAMP_STEPS` steps; it stops when the out-of-balance force ‖M a‖ (elastic and
-//!   contact forces together) is below `residual` × ‖F‖ (default 1e-10).
+//!   contact forces together) is below `residual` × ‖F‖ (default 1e-10). With
+//!   `pressure_first` the pressure's tractions are relaxed so first, then the shear's are ramped
+//!   in over as many steps on top of them and relaxed again (`relax_shear_at_full_pressure`).
 //! - `slide` runs the dynamic stage from rest with gravity for `duration`.
 //! - `newmark` relaxes gravity (the scene's `equilibrium`), then runs the record; the slip is
 //!   measured from the relaxed state.
@@ -98,10 +100,17 @@ fn failed(message: String) -> Error {
 pub fn run_case(case: &Case) -> Result<CaseResult, Error> {
     let scene: Scene = serde_json::from_value(case.scene.clone()).map_err(|e| failed(format!("generated scene does not parse: {e}")))?;
     let mut pb = Problem::build(scene, case.mesh.clone())?;
+    // the pressure-first path's shear forces, ramped in after the pressure's equilibrium
+    let mut shear_forces = Vec::new();
     if case.spec.kind == Kind::Patch {
         // the tractions act as static loads (what relaxation applies), not as dynamic patterns
         for p in std::mem::take(&mut pb.loads.patterns) {
             pb.loads.static_forces.extend(p.forces);
+        }
+        if case.spec.pressure_first {
+            let (f_p, f_tau) = pressure_and_shear_forces(case, &pb)?;
+            pb.loads.static_forces = f_p;
+            shear_forces = f_tau;
         }
     }
     let mut sim = Simulation::new(&pb)?;
@@ -116,7 +125,11 @@ pub fn run_case(case: &Case) -> Result<CaseResult, Error> {
                 let zero = vec![0.0; sim.state.u.len()];
                 crate::statics::sequence::grout_pairs(&pb, &mut sim.state.contact, &zero, |_, _| true)?;
             }
-            let eq = sim.relax(case.spec.residual, 400_000)?;
+            let mut eq = sim.relax(case.spec.residual, 400_000)?;
+            if case.spec.pressure_first {
+                let shear = relax_shear_at_full_pressure(&mut sim, &shear_forces, case.spec.residual, 400_000)?;
+                eq = crate::dynamics::EquilibriumInfo { steps: eq.steps + shear.steps, converged: eq.converged && shear.converged, residual: shear.residual };
+            }
             (measure_patch(case, &sim, eq.converged, eq.residual), eq.steps)
         }
         (Reference::Slide { slip, .. }, Kind::Slide) => {
@@ -177,6 +190,78 @@ pub fn run_case(case: &Case) -> Result<CaseResult, Error> {
         errors,
         lost: sim.state.contact.joints[0].events.lost,
     })
+}
+
+/// The patch's nodal forces split for the pressure-first path: (F_p, F − F_p), F_p the
+/// tractions of the pressure-only state (the case with τ = 0) on the same model, F the case's
+/// (already in `pb.loads.static_forces`). Tractions are linear in (p, τ), so F − F_p is the
+/// shear state's.
+fn pressure_and_shear_forces(case: &Case, pb: &Problem) -> Result<(NodeForces, NodeForces), Error> {
+    let mut r0 = case.spec.clone();
+    r0.shear = 0.0;
+    let mut scene = case.scene.clone();
+    scene["loads"]["traction"] = serde_json::Value::Array(super::patch_tractions(&r0).into_iter().map(|(g, t)| serde_json::json!({"group": g, "traction": t})).collect());
+    let scene: Scene = serde_json::from_value(scene).map_err(|e| failed(format!("pressure-only scene does not parse: {e}")))?;
+    let (loads, _) = crate::dynamics::loads::Loads::build(&pb.model, &scene)?;
+    let n = pb.model.n_nodes();
+    let (mut full, mut fp) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+    for &(i, f) in &pb.loads.static_forces {
+        (0..3).for_each(|c| full[i][c] += f[c]);
+    }
+    for &(i, f) in loads.patterns.iter().flat_map(|p| p.forces.iter()) {
+        (0..3).for_each(|c| fp[i][c] += f[c]);
+    }
+    let sparse = |v: Vec<[f64; 3]>| v.into_iter().enumerate().filter(|(_, f)| f.iter().any(|&x| x != 0.0)).collect::<NodeForces>();
+    let tau: Vec<[f64; 3]> = full.iter().zip(&fp).map(|(a, b)| [a[0] - b[0], a[1] - b[1], a[2] - b[2]]).collect();
+    Ok((sparse(fp), sparse(tau)))
+}
+
+/// (node, force [N]) lists.
+type NodeForces = Vec<(usize, [f64; 3])>;
+
+/// The second stage of the pressure-first path: from the pressure's equilibrium, the shear
+/// forces `f_tau` ramped in over `RELAXATION_RAMP_STEPS` steps on top of the full pressure
+/// forces (`static_forces` of the problem), relaxed by the same adaptive dynamic relaxation as
+/// `dynamics::relax_gravity` (its balance and damping rules, `relaxation_balance` and
+/// `relaxation_damping`) until ‖M a‖ < `tol` ‖F‖, F the full load.
+fn relax_shear_at_full_pressure(sim: &mut Simulation<'_>, f_tau: &[(usize, [f64; 3])], tol: f64, max_steps: usize) -> Result<crate::dynamics::EquilibriumInfo, Error> {
+    use crate::constraint::Constraint;
+    use crate::contact::ContactState;
+    use crate::dynamics::{relaxation_balance, relaxation_damping, Stage, RELAXATION_RAMP_STEPS};
+    let pb = sim.problem;
+    let model = &pb.model;
+    let mut loads = pb.loads.clone();
+    let mut f = vec![0.0; 3 * model.n_nodes()];
+    for &(i, v) in pb.loads.static_forces.iter().chain(f_tau) {
+        (0..3).for_each(|c| f[3 * i + c] += v[c]);
+    }
+    let norm_f = f.iter().enumerate().filter(|(i, _)| model.is_free(i / 3, i % 3)).map(|(_, x)| x * x).sum::<f64>().sqrt();
+    let (dt, mut alpha, mut residual) = (sim.solver.dt, 0.0, f64::INFINITY);
+    for k in 0..max_steps {
+        crate::interrupt::check_every(k, "the patch's shear stage (relaxation)")?;
+        let s = ((k + 1) as f64 / RELAXATION_RAMP_STEPS as f64).min(1.0);
+        loads.static_forces.clear();
+        loads.static_forces.extend(pb.loads.static_forces.iter().copied().chain(f_tau.iter().map(|&(i, v)| (i, [s * v[0], s * v[1], s * v[2]]))));
+        let mut cs: Vec<&mut dyn Constraint<ContactState>> = Vec::with_capacity(2);
+        if let Some(c) = sim.contact.as_mut() {
+            cs.push(c);
+        }
+        if let Some(fd) = sim.foundation.as_mut() {
+            cs.push(fd);
+        }
+        sim.solver.step(model, &loads, &mut sim.state, Stage::Relaxation(alpha, 1.0), &mut cs)?;
+        let (r2, ukb, umu) = relaxation_balance(model, &sim.solver, &sim.state, alpha, 1.0);
+        residual = r2.max(0.0).sqrt() / norm_f;
+        alpha = relaxation_damping(ukb, umu, dt, alpha);
+        if residual < tol && k + 1 >= RELAXATION_RAMP_STEPS {
+            sim.state.u_prev.copy_from_slice(&sim.state.u);
+            sim.complete_state()?;
+            return Ok(crate::dynamics::EquilibriumInfo { steps: k + 1, residual, converged: true });
+        }
+    }
+    sim.state.u_prev.copy_from_slice(&sim.state.u);
+    sim.complete_state()?;
+    Ok(crate::dynamics::EquilibriumInfo { steps: max_steps, residual, converged: false })
 }
 
 fn measure_patch(case: &Case, sim: &Simulation<'_>, converged: bool, residual: f64) -> Errors {

@@ -99,10 +99,11 @@ const HEX_TET_PAIRS: [(&str, &str, &str); 9] = [
 /// ≤ 7.8e-7, hex 4/3 slave lower) and 2e-6 on the force of each slave node (measured ≤ 1.4e-6,
 /// tet 4/3). Mixed sides are left out: a conforming mixed 3/3 block pair tied node to node
 /// misses uniform shear by 2 % too (the mesh's hex–tet columns, not the joint), checked below
-/// to be the same with mortar. The frictional joint (μ = 0.6) measures 1.5e-4 on hex 4/3 (bound
-/// 2.5e-4): the patch ramps p and τ together from zero, so in the first steps the pairs carry
-/// shear at nearly zero pressure and slip (μ = 10 gives 5.2e-5, conforming NTS with μ = 0.6
-/// 6.6e-5): the testcase's loading path, not the mortar integrals (docs/validation.md §8).
+/// to be the same with mortar. The frictional joint (μ = 0.6) on the proportional load path
+/// measures 1.5e-4 on hex 4/3 (bound 2.5e-4): p and τ ramped together from zero, the pairs carry
+/// shear at nearly zero pressure in the first steps and slip (μ = 10 gives 5.2e-5, conforming
+/// NTS with μ = 0.6 6.6e-5): the loading path, not the mortar integrals; on the pressure-first
+/// path it passes (`mortar_frictional_shear_patch_passes_pressure_first`).
 #[test]
 fn mortar_patch_shear_passes_on_every_hex_and_tet_pair() {
     let mut worst: (f64, f64) = (0.0, 0.0);
@@ -120,6 +121,44 @@ fn mortar_patch_shear_passes_on_every_hex_and_tet_pair() {
     let mixed = |method: &str| case(json!({"kind": "patch", "lower": "mixed:3", "upper": "mixed:3", "slave": "upper", "shear": 3e5, "tied": true, "method": method})).error;
     let (ntn, mortar) = (mixed("ntn"), mixed("mortar"));
     assert!((mortar - ntn).abs() < 1e-6 * ntn, "conforming mixed shear: mortar {mortar:.6e} vs node-to-node {ntn:.6e}");
+}
+
+/// Frictional shear (μ = 0.6, p = 1 MPa, τ = 0.3 MPa < μ p) on the pressure-first load path
+/// (`pressure_first`: p relaxed to equilibrium, then τ ramped in at full p), on every hex and
+/// tet pair of the matrix. Reference: the patch's uniform state; on this path a joint with
+/// |τ| < μ p sticks throughout, so the frictional joint must pass as the tied one does. Bound
+/// 1e-6 of max(p, |τ|) on σ next to the joint (issue 31; measured 3.6e-10 to 2.7e-7), except
+/// tet 4/3 slave lower: 2.571e-6, which a tied joint on the same path gives to the digit (and
+/// to 5.7e-7 on the proportional path): the static solve's path with a tie on that pair, not
+/// friction; that pair is held to 1.25 × its measurement and to the tied run within 1e-6 of it.
+/// The proportional path on hex 4/3 is checked to stay above 1e-5 (measured 1.49e-4), so the
+/// option is what makes the difference.
+#[test]
+fn mortar_frictional_shear_patch_passes_pressure_first() {
+    let mut worst: f64 = 0.0;
+    for (lower, upper, slave) in HEX_TET_PAIRS {
+        let v = json!({"kind": "patch", "lower": lower, "upper": upper, "slave": slave, "shear": 3e5, "mu": 0.6, "pressure_first": true, "method": "mortar"});
+        let r = case(v.clone());
+        let (s, _, _) = patch_errors(&r);
+        println!("MEASURED {v}: σ {s:.3e}");
+        if (lower, upper, slave) == ("tet4:4", "tet4:3", "lower") {
+            let mut tied = v.clone();
+            tied["tied"] = json!(true);
+            let t = patch_errors(&case(tied)).0;
+            assert!(s < 1.25 * 2.571e-6 && (s - t).abs() < 1e-6 * t, "{v}: σ {s:.3e}, tied on the same path {t:.3e}");
+            continue;
+        }
+        worst = worst.max(s);
+        assert!(s < 1e-6, "{v}: σ {s:.2e}");
+    }
+    println!("worst σ {worst:.2e}");
+    let proportional = case(json!({"kind": "patch", "lower": "hex8:4", "upper": "hex8:3", "slave": "lower", "shear": 3e5, "method": "mortar"}));
+    assert!(proportional.error > 1e-5, "the proportional path passes too ({:.3e}): the pressure-first option no longer matters", proportional.error);
+    // the option needs shear (without it the two paths are one) and the patch kind
+    for bad in [json!({"kind": "patch", "pressure_first": true}), json!({"kind": "slide", "pressure_first": true})] {
+        let spec: jointquake::testcase::CaseSpec = serde_json::from_value(bad.clone()).unwrap();
+        assert!(spec.resolved().is_err(), "{bad} accepted");
+    }
 }
 
 /// The dynamic kinds with mortar against the NTS figures of docs/validation.md §8 (bounds 1.25 ×
