@@ -634,3 +634,24 @@ fn record_pairs_into(problem: &Problem, pairs: &[Pair], uh: &[f64], contact: &mu
     }
     info.condition_violation = if info.max_normal_force > 0.0 { tension.max(0.0) / info.max_normal_force } else { 0.0 };
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forcing_term_follows_eisenstat_walker_within_its_bounds() {
+        // Reference: Eisenstat & Walker 1996, choice 2, η = 0.9 (res/res_prev)² with the
+        // safeguard max(η, 0.9 η_prev²) when 0.9 η_prev² > 0.1; exact to round-off (1e-15).
+        // first iteration: the cap
+        assert_eq!(forcing_term(1.0, None, 0.0), FORCING_MAX);
+        // slow progress: 0.9 × 0.5² = 0.225, capped at FORCING_MAX
+        assert_eq!(forcing_term(0.5, Some(1.0), FORCING_MAX), FORCING_MAX);
+        // fast progress far from the tolerance: 0.9 × 1e-2² = 9e-5
+        assert!((forcing_term(1e-3, Some(1e-1), FORCING_MAX) - 9e-5).abs() < 1e-15);
+        // near the tolerance: never tighter than 0.1 × TOLERANCE / res (1e-9 / 1e-6 = 1e-3)
+        assert!((forcing_term(1e-6, Some(1e-2), 1e-3) - 1e-3).abs() < 1e-15);
+        // very fast progress: floored at 0.1 × TOLERANCE / res (1e-8 here), never below DIRECTION_TOLERANCE
+        assert_eq!(forcing_term(1e-1, Some(1e6), 1e-3), DIRECTION_TOLERANCE.max(0.1 * TOLERANCE / 1e-1));
+    }
+}
