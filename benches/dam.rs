@@ -260,8 +260,9 @@ fn main() {
         }
     });
     let reservoir = pool.install(|| reservoir_models(repeats, steps));
+    let static_rows = static_state();
     let _ = std::fs::create_dir_all(root().join("target/bench"));
-    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir})).unwrap());
+    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir, "static_state": static_rows})).unwrap());
 }
 
 /// The step with each reservoir model against the Westergaard step (issue 28; goals:
@@ -366,4 +367,75 @@ fn dense_wet_solve_ms(n: usize) -> (usize, f64, f64) {
     let b = nalgebra::DVector::<f64>::from_element(n, 1.0);
     let solve = (0..5).map(|_| { let t = Instant::now(); let x = ch.solve(&b); std::hint::black_box(x); t.elapsed().as_secs_f64() }).fold(f64::INFINITY, f64::min);
     (n, factor, 1e3 * solve)
+}
+
+/// CPU seconds (user + system) of this process and its peak resident set [MB] (getrusage).
+fn cpu_and_peak() -> (f64, f64) {
+    // SAFETY: getrusage writes the struct it is given; a zeroed rusage is a valid value
+    let mut r: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut r) };
+    let s = |t: libc::timeval| t.tv_sec as f64 + 1e-6 * t.tv_usec as f64;
+    (s(r.ru_utime) + s(r.ru_stime), r.ru_maxrss as f64 / 1024.0)
+}
+
+/// The dam's construction-sequence static state (issue 30 §1; `jointquake dam-static`, stages a
+/// to c) per mesh of `JQ_DAM_STATIC` (comma list of coarse, default, fine, h2.5; unset or empty
+/// skips it): the scene pipelines/dam.json with the mesh's `geometry.set` (coarse: h 20, ht 3.4,
+/// hr 40, hrf 200; fine: h 5, ht 1.25, hr 12.5, hrf 80; h2.5: h 2.5, ht 0.625, hr 6.25, hrf 40),
+/// meshed into target/bench-mesh, solved by `pipeline::run_inspect` with duration 0 (outputs in
+/// target/bench-static). Prints per mesh the wall and CPU time of the run (meshing excluded:
+/// the mesh is made first), the stages' notes (stage a: unknowns, assembly and Cholesky time,
+/// factor size; stage c: Newton iterations, factorisations, GMRES products, their times), and
+/// the process's peak RSS so far (sizes in the order given, so list them smallest first: the
+/// peak is then the last mesh's). Goals: fine ≤ 120 s and ≤ 3 GB, h2.5 ≤ 15 min and ≤ 16 GB.
+fn static_state() -> Vec<serde_json::Value> {
+    let sizes = std::env::var("JQ_DAM_STATIC").unwrap_or_default();
+    let mut rows = Vec::new();
+    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let set: serde_json::Value = match size {
+            "coarse" => serde_json::json!({"h": 20, "ht": 3.4, "hr": 40, "hrf": 200}),
+            "default" => serde_json::json!({}),
+            "fine" => serde_json::json!({"h": 5, "ht": 1.25, "hr": 12.5, "hrf": 80}),
+            "h2.5" => serde_json::json!({"h": 2.5, "ht": 0.625, "hr": 6.25, "hrf": 40}),
+            other => panic!("JQ_DAM_STATIC: unknown mesh \"{other}\" (coarse, default, fine, h2.5)"),
+        };
+        let text = std::fs::read_to_string(root().join("pipelines/dam.json")).expect("pipelines/dam.json");
+        let mut scene: serde_json::Value = serde_json::from_str(&text).expect("pipelines/dam.json is JSON");
+        scene["geometry"] = serde_json::json!({"geo": root().join("geo/arch_dam.geo"), "set": set});
+        for rec in scene["loads"]["base"].as_array_mut().into_iter().flatten() {
+            let r = root().join("pipelines").join(rec["record"].as_str().unwrap_or_default());
+            rec["record"] = serde_json::json!(r);
+        }
+        let dir = root().join("target/bench-static");
+        let _ = std::fs::create_dir_all(&dir);
+        let path = dir.join(format!("dam_{size}.json"));
+        std::fs::write(&path, serde_json::to_string_pretty(&scene).unwrap()).expect("writing the bench scene");
+        let cache = root().join("target/bench-mesh");
+        let t_mesh = Instant::now();
+        let loaded = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|s| jointquake::pipeline::load_mesh(&s, Some(&cache)).map_err(|e| e.to_string()));
+        if let Err(e) = loaded {
+            println!("static state, {size}: skipped ({e})");
+            continue;
+        }
+        let mesh_s = t_mesh.elapsed().as_secs_f64();
+        let opts = jointquake::pipeline::RunOptions { out_dir: Some(dir.join(size)), mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
+        let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
+        let (cpu0, _) = cpu_and_peak();
+        let t0 = Instant::now();
+        let summary = jointquake::pipeline::run_inspect(&path, &opts, &mut |_, _| Ok(()));
+        let wall = t0.elapsed().as_secs_f64();
+        let (cpu1, peak_mb) = cpu_and_peak();
+        match summary {
+            Ok(s) => {
+                let stages: Vec<&String> = s.notes.iter().filter(|n| n.starts_with("static sequence")).collect();
+                println!("static state, {size} (load average {load}): {wall:.1} s wall, {:.1} s CPU, peak RSS {peak_mb:.0} MB (meshing {mesh_s:.1} s before)", cpu1 - cpu0);
+                for n in &stages {
+                    println!("    {n}");
+                }
+                rows.push(serde_json::json!({"mesh": size, "set": scene["geometry"]["set"], "load_before": load, "wall_s": wall, "cpu_s": cpu1 - cpu0, "peak_rss_mb": peak_mb, "mesh_s": mesh_s, "stages": stages}));
+            }
+            Err(e) => println!("static state, {size}: failed after {wall:.1} s ({e})"),
+        }
+    }
+    rows
 }

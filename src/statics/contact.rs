@@ -10,7 +10,8 @@
 //! pair's tangent, on the model with the tied joints eliminated (`bonded`). Each direction
 //! K_T⁻¹ R is solved by GMRES preconditioned by the sparse Cholesky factorisation of K_T
 //! without the friction coupling (symmetric positive definite), analysed once and factorised
-//! again only when pairs change state ([`TangentSolver`]); a sparse LU of the assembled K_T is
+//! again only when GMRES needs many products ([`TangentSolver`]), to an Eisenstat–Walker
+//! forcing term ([`forcing_term`]); a sparse LU of the assembled K_T is
 //! the fallback when GMRES does not converge. The LU on every iteration, as first written, took
 //! 1243 s and 11 GB on the fine dam mesh (faer's LU orders the columns by COLAMD and bounds
 //! the fill by the pattern of AᵀA: docs/performance.md, "Static state").
@@ -109,17 +110,25 @@ pub struct StaticContactInfo {
     pub condition_violation: f64,
     /// How the Newton directions were solved (GMRES on the preconditioner's factorisations).
     pub solver: DirectionStats,
+    /// Wall time of the whole increment and of its setup (stiffness, ties, pairs) [s].
+    pub seconds: f64,
+    pub setup_seconds: f64,
 }
 
 impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations ({} factorisations, {} GMRES products{}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations ({} factorisations in {:.1} s, {} GMRES products in {:.1} s{}; {:.1} s in all, setup {:.1} s; factor {:.0} MB), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
             self.solver.factorisations,
+            self.solver.factor_seconds,
             self.solver.krylov_products,
+            self.solver.krylov_seconds,
             if self.solver.lu_fallbacks > 0 { format!(", {} LU solves", self.solver.lu_fallbacks) } else { String::new() },
+            self.seconds,
+            self.setup_seconds,
+            self.solver.factor_entries as f64 * 8e-6,
             self.residual,
             if self.converged { "" } else { " (NOT converged)" },
             self.stick,
@@ -185,11 +194,39 @@ fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, h
     }
 }
 
-/// Relative tolerance of each Newton direction's GMRES solve, ‖K_T d − R‖ ≤ this × ‖R‖
-/// (dimensionless): 1e-9. Why: Newton then converges as with an exact solve down to
-/// [`TOLERANCE`] (an inexact Newton step with a forcing term this small keeps the quadratic
-/// convergence far below the 1e-8 asked), and it costs a few more products than 1e-6.
+/// Smallest relative tolerance of a Newton direction's GMRES solve, ‖K_T d − R‖ ≤ η ‖R‖
+/// (dimensionless): 1e-9. Why: below it the solve is at the factorisation's round-off; the
+/// forcing term η of each iteration ([`forcing_term`]) is never asked below this.
 pub const DIRECTION_TOLERANCE: f64 = 1e-9;
+
+/// Largest forcing term η of an inexact Newton step (dimensionless): 1e-2. Why: the contact law
+/// is only piecewise smooth and far from the solution the line search cuts most steps, so a
+/// direction 1 % off finds the pairs' states as well as an exact one (on the coarse dam: 12
+/// Newton iterations against 11 with 1e-9, half the GMRES products); looser ones
+/// (Eisenstat and Walker allow 0.9) were not tried.
+pub const FORCING_MAX: f64 = 1e-2;
+
+/// The forcing term of the Newton iteration at the relative residual `res` after one of
+/// `res_prev` (`None` at the first) with the forcing term `eta_prev`: Eisenstat and Walker's
+/// choice 2 (SIAM J. Sci. Comput. 17, 1996), η = γ (res / res_prev)², γ = 0.9, with their
+/// safeguard max(η, γ η_prev²) when γ η_prev² > 0.1, capped by [`FORCING_MAX`]; and never
+/// tighter than needed to reach [`TOLERANCE`] in this step (0.1 × TOLERANCE / res, so the
+/// linear residual left is a tenth of the one asked of Newton) nor than
+/// [`DIRECTION_TOLERANCE`]. The iteration's convergence test on the true residual is unchanged.
+fn forcing_term(res: f64, res_prev: Option<f64>, eta_prev: f64) -> f64 {
+    const GAMMA: f64 = 0.9;
+    let ew = match res_prev {
+        None => FORCING_MAX,
+        Some(rp) if rp > 0.0 => {
+            let e = GAMMA * (res / rp).powi(2);
+            let safeguard = GAMMA * eta_prev * eta_prev;
+            if safeguard > 0.1 { e.max(safeguard) } else { e }
+        }
+        Some(_) => DIRECTION_TOLERANCE,
+    };
+    let enough = if res > 0.0 { 0.1 * TOLERANCE / res } else { 1.0 };
+    ew.min(FORCING_MAX).max(enough.min(FORCING_MAX)).max(DIRECTION_TOLERANCE)
+}
 
 /// How the Newton directions were solved: factorisations of the preconditioner, GMRES
 /// products, direct LU solves (the fallback), and the seconds each took.
@@ -208,11 +245,14 @@ pub struct DirectionStats {
 /// of [`PairTangent`], applied pair by pair, never assembled): GMRES
 /// (`linalg::krylov::gmres_into`) preconditioned by the sparse Cholesky factorisation of the
 /// symmetric positive definite P = K̂ + Σ_p B_pᵀ S_p B_p. P's pattern (K̂ and every pair's block,
-/// open or not) is analysed once (AMD ordering); P is factorised again only when a pair changed
-/// its state since the last factorisation or GMRES needed more than [`REFACTOR_PRODUCTS`]
-/// products, so iterations that only move the slipping pairs reuse it. K_T − P is the friction
-/// couplings C_p (one rank-one term per slipping pair) and the slipping pairs' changed
-/// stiffness since the factorisation.
+/// open or not) is analysed once (AMD ordering); P is factorised again only when the last
+/// direction's GMRES needed more than [`REFACTOR_PRODUCTS`] products (or did not converge), not
+/// on every change of a pair's state: K_T − P is then the friction couplings C_p (one rank-one
+/// term per slipping pair) and the changed blocks of the pairs that opened, slipped or moved
+/// since the factorisation, a correction of low rank that GMRES absorbs in a few products
+/// (on the fine dam a numeric factorisation costs as much as some hundred products).
+/// GMRES starts each direction from 0: the Newton directions of successive iterations are not
+/// close (the residual changes by orders of magnitude), so the last one is no better a start.
 struct TangentSolver {
     p: Csc,
     /// Per entry of K̂, its position in `p.val`.
@@ -221,17 +261,18 @@ struct TangentSolver {
     /// position in `p.val`.
     pair_pos: Vec<usize>,
     chol: Option<SparseCholesky>,
-    /// The states the factorisation was made with.
-    factored_states: Vec<PairState>,
     stale_products: bool,
     stats: DirectionStats,
     y: Vec<f64>,
 }
 
-/// GMRES products above which the next direction refactorises the preconditioner: 40. Why: a
-/// fresh factorisation needs a handful; many more mean the slipping pairs have moved far
-/// from the stiffness it was made with.
-pub const REFACTOR_PRODUCTS: usize = 40;
+/// GMRES products above which the next direction refactorises the preconditioner: 15. Why: a
+/// fresh factorisation needs 1 to 3 products at the forcing term 1e-2, a stale one 20 to 80;
+/// on the default dam mesh one numeric factorisation costs about 15 products, and 15 took less
+/// CPU there than 40 or a refactorisation at every change of a pair's state (11.4 s against
+/// 16.0 s and 12.8 s: docs/performance.md §7b).
+pub const REFACTOR_PRODUCTS: usize = 15;
+
 
 impl TangentSolver {
     fn new(k0: &Csc, pairs: &[Pair]) -> TangentSolver {
@@ -257,7 +298,7 @@ impl TangentSolver {
         }
         let pair_pos = entries.iter().map(|&(a, b, _)| pos(a, b)).collect();
         let n = k0.n_rows;
-        TangentSolver { p, k0_pos, pair_pos, chol: None, factored_states: Vec::new(), stale_products: false, stats: DirectionStats::default(), y: vec![0.0; n] }
+        TangentSolver { p, k0_pos, pair_pos, chol: None, stale_products: false, stats: DirectionStats::default(), y: vec![0.0; n] }
     }
 
     /// P's values for the tangents `tangents`, then its numeric factorisation.
@@ -287,7 +328,6 @@ impl TangentSolver {
             None => SparseCholesky::factor(&self.p, what, faer::Par::Seq).map(|ch| self.chol = Some(ch)),
         }
         .map_err(|e| ModelError::Invalid(e.to_string()))?;
-        self.factored_states = tangents.iter().map(|t| t.state).collect();
         self.stale_products = false;
         self.stats.factorisations += 1;
         self.stats.factor_entries = self.chol.as_ref().map_or(0, |c| c.factor_entries());
@@ -295,14 +335,17 @@ impl TangentSolver {
         Ok(())
     }
 
-    /// r ← K_T⁻¹ r.
-    fn direction_in_place(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent], r: &mut [f64]) -> Result<(), Error> {
-        let changed = self.chol.is_none() || self.stale_products || self.factored_states.iter().zip(tangents).any(|(s, t)| *s != t.state);
+    /// r ← K_T⁻¹ r, to the relative residual `eta` (the forcing term).
+    fn direction_in_place(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent], r: &mut [f64], eta: f64) -> Result<(), Error> {
+        let changed = self.chol.is_none() || self.stale_products;
         if changed {
             self.factorise(k0, pairs, tangents)?;
         }
-        let opts = GmresOptions { tolerance: DIRECTION_TOLERANCE, ..Default::default() };
         for attempt in 0..2 {
+            // a preconditioner made at older states gets a few times the products that call for
+            // a refactorisation, then is refactorised at these states
+            let fresh = changed || attempt > 0;
+            let opts = GmresOptions { tolerance: eta, max_iterations: if fresh { GmresOptions::default().max_iterations } else { 3 * REFACTOR_PRODUCTS }, ..Default::default() };
             let start = std::time::Instant::now();
             let chol = self.chol.as_mut().expect("factorised above");
             self.y.fill(0.0);
@@ -329,7 +372,7 @@ impl TangentSolver {
                 r.copy_from_slice(&self.y);
                 return Ok(());
             }
-            if attempt == 0 && !changed {
+            if !fresh {
                 // a stale preconditioner: factorise at this state and try again
                 self.factorise(k0, pairs, tangents)?;
                 continue;
@@ -380,6 +423,7 @@ fn mortar_points(problem: &Problem, contact: &ContactState, ji: usize) -> Result
 }
 
 pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64) -> Result<(Vec<f64>, StaticContactInfo), Error> {
+    let start = std::time::Instant::now();
     let model = &problem.model;
     let k_full = stiffness(model, &vec![true; model.materials.len()]);
     let tied: Vec<&ContactJoint> = problem.joints.iter().filter(|j| j.law.tied).collect();
@@ -389,12 +433,14 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let mut info = StaticContactInfo::default();
     let mut pairs = active_pairs(problem, &t, &k_full, contact, penalty_factor, &mut info)?;
     let residual = Residual { k0: &k0, f0: &f0, joints: &problem.joints, nf: norm(&f0) };
+    info.setup_seconds = start.elapsed().as_secs_f64();
     let uh = newton(&residual, &mut pairs, t.n, &mut info)?;
     // the result and the pairs' records
     let mut du = vec![0.0; t.n_dofs];
     t.expand_into(&uh, &mut du);
     info.max_displacement = (0..model.n_nodes()).map(|n| Vector3::new(du[3 * n], du[3 * n + 1], du[3 * n + 2]).norm()).fold(0.0, f64::max);
     record_pairs_into(problem, &pairs, &uh, contact, &mut info);
+    info.seconds = start.elapsed().as_secs_f64();
     Ok((du, info))
 }
 
@@ -514,6 +560,7 @@ fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, info: &mut StaticCo
     let mut tangents = Vec::with_capacity(pairs.len());
     let mut u_try = vec![0.0; n];
     let mut solver = TangentSolver::new(k0, pairs);
+    let (mut res_prev, mut eta) = (None, FORCING_MAX);
     for it in 0..=MAX_ITERATIONS {
         crate::interrupt::check("the static state (Newton iterations with contact)")?;
         info.residual = residual.evaluate_into(&uh, pairs, &mut r, Some(&mut tangents), &mut closed);
@@ -528,7 +575,9 @@ fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, info: &mut StaticCo
             info.converged = info.residual < TOLERANCE;
             break;
         }
-        solver.direction_in_place(k0, pairs, &tangents, &mut r)?;
+        eta = forcing_term(info.residual, res_prev, eta);
+        res_prev = Some(info.residual);
+        solver.direction_in_place(k0, pairs, &tangents, &mut r, eta)?;
         // backtracking line search on ‖R‖ (Armijo, halving): the law is only piecewise smooth
         let mut step = 1.0;
         for _ in 0..LINE_SEARCH_HALVINGS {
@@ -584,4 +633,25 @@ fn record_pairs_into(problem: &Problem, pairs: &[Pair], uh: &[f64], contact: &mu
         }
     }
     info.condition_violation = if info.max_normal_force > 0.0 { tension.max(0.0) / info.max_normal_force } else { 0.0 };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn forcing_term_follows_eisenstat_walker_within_its_bounds() {
+        // Reference: Eisenstat & Walker 1996, choice 2, η = 0.9 (res/res_prev)² with the
+        // safeguard max(η, 0.9 η_prev²) when 0.9 η_prev² > 0.1; exact to round-off (1e-15).
+        // first iteration: the cap
+        assert_eq!(forcing_term(1.0, None, 0.0), FORCING_MAX);
+        // slow progress: 0.9 × 0.5² = 0.225, capped at FORCING_MAX
+        assert_eq!(forcing_term(0.5, Some(1.0), FORCING_MAX), FORCING_MAX);
+        // fast progress far from the tolerance: 0.9 × 1e-2² = 9e-5
+        assert!((forcing_term(1e-3, Some(1e-1), FORCING_MAX) - 9e-5).abs() < 1e-15);
+        // near the tolerance: never tighter than 0.1 × TOLERANCE / res (1e-9 / 1e-6 = 1e-3)
+        assert!((forcing_term(1e-6, Some(1e-2), 1e-3) - 1e-3).abs() < 1e-15);
+        // very fast progress: floored at 0.1 × TOLERANCE / res (1e-8 here), never below DIRECTION_TOLERANCE
+        assert_eq!(forcing_term(1e-1, Some(1e6), 1e-3), DIRECTION_TOLERANCE.max(0.1 * TOLERANCE / 1e-1));
+    }
 }
