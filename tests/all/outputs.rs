@@ -375,6 +375,10 @@ fn every_committed_scene_loads() {
                 // a study file (pipelines/wedge_study.json) names a scene; it must load and so must its scene
                 let (st, _) = jointquake::studies::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
                 jointquake::scene::Scene::load(&st.scene).unwrap_or_else(|e| panic!("{}: {e}", st.scene.display()));
+            } else if p.file_stem().is_some_and(|s| s.to_string_lossy().ends_with("_reference")) {
+                // an extrapolated reference (pipelines/dam_reference.json, `jointquake study
+                // extrapolate`) is not a scene: it must read back through its typed reader
+                jointquake::studies::dam::reference::DamReference::read(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
             } else {
                 jointquake::scene::Scene::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
             }
