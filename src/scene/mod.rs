@@ -843,27 +843,33 @@ impl JointSceneSpec {
 
 impl Scene {
     /// Read and validate a scene file; relative paths are resolved against its directory.
+    /// Resolve the scene's relative file paths (geometry `.geo`/`.msh`, base records and
+    /// spectrum tables) against `dir`: the directory of the file that wrote them (the scene
+    /// file itself, or the study file whose axis patched them in).
+    pub fn resolve_paths_against(&mut self, dir: &Path) {
+        let resolve = |p: &mut PathBuf| {
+            if p.is_relative() {
+                *p = dir.join(&*p);
+            }
+        };
+        if let Some(g) = self.geometry.geo.as_mut() {
+            resolve(g);
+        }
+        if let Some(m) = self.geometry.msh.as_mut() {
+            resolve(m);
+        }
+        for b in &mut self.loads.base {
+            b.map_paths(&resolve);
+        }
+    }
+
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text = crate::files::read_text_bounded(path, crate::files::MAX_TEXT_INPUT).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
         let mut scene: Scene = serde_json::from_str(&text).map_err(|e| SceneError::Parse {
             path: path.to_path_buf(),
             message: format!("{e} (see docs/scenes.md for the fields)"),
         })?;
-        let base = path.parent().unwrap_or(Path::new("."));
-        let resolve = |p: &mut PathBuf| {
-            if p.is_relative() {
-                *p = base.join(&*p);
-            }
-        };
-        if let Some(g) = scene.geometry.geo.as_mut() {
-            resolve(g);
-        }
-        if let Some(m) = scene.geometry.msh.as_mut() {
-            resolve(m);
-        }
-        for b in &mut scene.loads.base {
-            b.map_paths(&resolve);
-        }
+        scene.resolve_paths_against(path.parent().unwrap_or(Path::new(".")));
         if scene.name.is_none() {
             // From the file name, with the characters a name may not hold replaced by `_`.
             let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();

@@ -278,6 +278,10 @@ pub fn variant_scene(study: &Study, base: &Value, labels: &[(String, String)], o
             }
         }
     }
+    // Paths a study patches in (an axis's record, a mesh) are written relative to the study
+    // file, like its base scene; the base's own are absolute already.
+    let study_dir = absolute(study.path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new(".")));
+    s.resolve_paths_against(&study_dir);
     s.name = Some(name.to_string());
     s.output.dir = None;
     s.validate().map_err(|e| invalid(format!("run {name}: {e}")))?;

@@ -266,3 +266,34 @@ fn history_table_reads_columns_by_name_and_names_what_is_wrong() {
     std::fs::write(&p, "# nothing\n").unwrap();
     assert!(HistoryTable::read(&p).unwrap_err().to_string().contains("no header"));
 }
+
+/// Regression (make dam, 4 December 2026: the six pulse runs failed): a record path that an
+/// axis patches in (`records/pulse_sin4_T0.6.txt` in pipelines/dam_study.json) was left
+/// relative in the run's scene, which the run then resolved against `out/<study>/scenes/`.
+/// Paths a study patches in resolve against the study file, like its base scene's.
+#[test]
+fn study_patch_record_path_resolves_against_the_study_file() {
+    let dir = scratch("study/patch_record_path");
+    let rec = manifest("pipelines/records/elcentro1940_NS_chopra.txt");
+    std::fs::create_dir_all(dir.join("records")).unwrap();
+    std::fs::copy(&rec, dir.join("records/patched.txt")).unwrap();
+    let p = write_study(
+        &dir,
+        &incline_scene(&rec, 1.0),
+        json!({"scene": "scene.json", "axes": [
+            {"name": "level", "values": [
+                {"label": "base"},
+                {"label": "patched", "scene": {"/loads/base": [{"record": "records/patched.txt", "direction": [1, 0, 0]}]}}
+            ]}
+        ]}),
+    );
+    let s = Study::load(&p).unwrap();
+    write_plan(&s, &[], &dir.join("cache"), "jointquake").unwrap();
+    let sc = jointquake::scene::Scene::load(&dir.join("out/scenes/patched.json")).unwrap();
+    let r = sc.loads.base[0].record.as_ref().unwrap();
+    assert!(r.is_absolute(), "{}", r.display());
+    assert_eq!(std::fs::canonicalize(r).unwrap(), std::fs::canonicalize(dir.join("records/patched.txt")).unwrap());
+    // the base scene's own record stays where it was
+    let b = jointquake::scene::Scene::load(&dir.join("out/scenes/base.json")).unwrap();
+    assert_eq!(std::fs::canonicalize(b.loads.base[0].record.as_ref().unwrap()).unwrap(), std::fs::canonicalize(&rec).unwrap());
+}
