@@ -155,9 +155,38 @@ pub fn verdict_above(a: f64, band_a: Option<f64>, b: f64, band_b: Option<f64>, a
     if (d > 0.0) == above { Verdict::Agreed } else { Verdict::NotAgreed }
 }
 
+/// The verdict on the claim "`b` is within `enough` (relative) of `a`", given each value's
+/// error band (`None`: unknown, so nothing is resolved): agreed when even the band's worst case
+/// keeps the difference within `enough` (|b − a| + √(b_a² + b_b²) ≤ enough |a|), not agreed
+/// when even its best case leaves it beyond (|b − a| − √(…) > enough |a|), else not resolved.
+pub fn verdict_close(a: f64, band_a: Option<f64>, b: f64, band_b: Option<f64>, enough: f64) -> Verdict {
+    let (Some(ba), Some(bb)) = (band_a, band_b) else { return Verdict::NotResolved };
+    let (d, band, limit) = ((b - a).abs(), ba.hypot(bb), enough * a.abs());
+    if !(d.is_finite() && band.is_finite() && limit.is_finite()) {
+        return Verdict::NotResolved;
+    }
+    if d + band <= limit {
+        Verdict::Agreed
+    } else if d - band > limit {
+        Verdict::NotAgreed
+    } else {
+        Verdict::NotResolved
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn closeness_verdicts_need_the_band_inside_or_outside_the_limit() {
+        // limit 10 % of 100 = 10: difference 3 with band 5 (3-4-5) is within at worst (8 ≤ 10);
+        // difference 16 with band 5 is beyond at best (11 > 10); difference 8 with band 5 neither
+        assert_eq!(verdict_close(100.0, Some(3.0), 103.0, Some(4.0), 0.1), Verdict::Agreed);
+        assert_eq!(verdict_close(100.0, Some(3.0), 84.0, Some(4.0), 0.1), Verdict::NotAgreed);
+        assert_eq!(verdict_close(100.0, Some(3.0), 108.0, Some(4.0), 0.1), Verdict::NotResolved);
+        assert_eq!(verdict_close(100.0, None, 100.0, Some(0.0), 0.1), Verdict::NotResolved);
+    }
 
     #[test]
     fn richardson_recovers_a_known_order_and_limit() {

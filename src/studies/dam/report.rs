@@ -8,7 +8,7 @@
 //! written). A new section is a function (in its own file under `studies/dam/` if it is large)
 //! and one call here.
 
-use super::convergence::verdict_above;
+use super::convergence::{verdict_above, verdict_close};
 use super::reference::{DamReference, Quantity as Q};
 use super::{DamKind, DamParams, DamRun, Method};
 use crate::error::Error;
@@ -1017,8 +1017,47 @@ impl ClaimRuns<'_> {
             .collect()
     }
 
-    /// NTS ≈ NTN below the top level.
+    /// NTS ≈ NTN below the top level: each low level on the extrapolated reference with its
+    /// bands where it has both methods' opening and net slip there ([`verdict_close`]), else on
+    /// the main mesh's numbers alone; not agreed if a level is, else not resolved if a level is.
     fn nts_near_ntn_below_top(&self) -> Claim {
+        use super::convergence::Verdict::*;
+        let mut c = self.nts_near_ntn_on_the_main_mesh();
+        let Some(rf) = self.reference else { return c };
+        let mut verdicts = Vec::new();
+        let mut texts = Vec::new();
+        for l in self.low() {
+            let (Some(a), Some(b)) = (self.find(l, Method::Nts), self.find(l, Method::Ntn)) else { return c };
+            let mut on_ref = Vec::new();
+            for q in [Q::Opening, Q::Slip] {
+                if let (Some(x), Some(y)) = (rf.get(q, Method::Nts, l), rf.get(q, Method::Ntn, l)) {
+                    let (ex, ey) = (&x.extrapolation, &y.extrapolation);
+                    on_ref.push(verdict_close(ex.extrapolated, ex.band, ey.extrapolated, ey.band, self.p.enough));
+                    let band = |v: Option<f64>| v.map_or("no band".into(), |v| format!("{} mm", mm(v)));
+                    texts.push(format!("{} {}: NTS {} mm ± {}, NTN {} mm ± {}", lvl(l), q.name().0, mm(ex.extrapolated), band(ex.band), mm(ey.extrapolated), band(ey.band)));
+                }
+            }
+            if on_ref.len() == 2 {
+                verdicts.extend(on_ref);
+            } else {
+                let close = rel(b.max_opening().1, a.max_opening().1).abs() <= self.p.enough && rel(b.max_slip().1, a.max_slip().1).abs() <= self.p.enough;
+                verdicts.push(if close { Agreed } else { NotAgreed });
+                texts.push(format!("{}: no reference, the main mesh's", lvl(l)));
+            }
+        }
+        if texts.is_empty() {
+            return c;
+        }
+        let v = if verdicts.contains(&NotAgreed) { NotAgreed } else if verdicts.contains(&NotResolved) { NotResolved } else { Agreed };
+        c.ours = format!("{} (main mesh); reference: {}", c.ours, texts.join("; "));
+        c.agreed = Some(v == Agreed);
+        c.not_resolved = v == NotResolved;
+        c.band = format!("per level on the reference: agreed when |NTN − NTS| + √(b_NTS² + b_NTN²) ≤ {} of NTS, not agreed when |NTN − NTS| − √(…) exceeds it, else not resolved", fmt_percent(self.p.enough, 0));
+        c
+    }
+
+    /// NTS ≈ NTN below the top level, on the main mesh's numbers.
+    fn nts_near_ntn_on_the_main_mesh(&self) -> Claim {
         let low = self.low();
         let mut ours = Vec::new();
         let mut ok = Some(true);
