@@ -16,6 +16,10 @@
 //!   `interrupted`.
 //! - **Monitors**: the scene's points snapped to nodes ([`snap_monitors`]).
 //! - **Peaks**: |u|, |v|, |a| of any node, sampled every [`PEAK_STRIDE`] steps and at the last.
+//! - **Displacement reference**: peaks and monitors report u relative to the free field, the
+//!   same frame for every foundation model (`problem::foundation::free_field::Frame`): the
+//!   integrated u of the massless and massed_fixed models already is; a radiating run's total
+//!   u has its free field taken off. v and a are reported as integrated.
 //! - **Progress**: a bar on stderr when asked for and stderr is a terminal; nothing otherwise.
 //! - **Envelopes**: stress envelopes on face groups ([`super::envelope`], `output.envelope`);
 //!   per-node joint envelopes of opening and net slip ([`super::joint_envelope`]).
@@ -33,6 +37,7 @@ use crate::contact::joint::Method;
 use crate::dynamics::Kinematics;
 use crate::error::{Error, ModelError, OutputError};
 use crate::model::Model;
+use crate::problem::foundation::free_field::{FreeField, Frame};
 use crate::problem::Problem;
 use crate::scene::Scene;
 use crate::simulation::{Observer, Simulation};
@@ -236,10 +241,12 @@ pub struct Peaks {
 }
 
 impl Peaks {
-    /// Update with the kinematics at t[n].
-    pub fn update(&mut self, model: &Model, kin: &Kinematics<'_>) {
+    /// Update with the kinematics at t[n]; the displacement relative to `reference` (node, t)
+    /// when given (a radiating foundation's free field, [`FreeFieldRef`]).
+    pub fn update(&mut self, model: &Model, kin: &Kinematics<'_>, reference: Option<FreeFieldRef<'_>>) {
         for n in 0..model.n_nodes() {
-            let m2 = kin.u[3 * n].powi(2) + kin.u[3 * n + 1].powi(2) + kin.u[3 * n + 2].powi(2);
+            let r = reference.map(|f| f.displacement(n, kin.t)).unwrap_or([0.0; 3]);
+            let m2 = (kin.u[3 * n] - r[0]).powi(2) + (kin.u[3 * n + 1] - r[1]).powi(2) + (kin.u[3 * n + 2] - r[2]).powi(2);
             if m2 > self.displacement.value * self.displacement.value {
                 self.displacement = Peak { value: m2.sqrt(), t: kin.t, node_tag: model.mesh.node_tags[n] };
             }
@@ -258,6 +265,20 @@ impl Peaks {
     }
 }
 
+/// The free field a radiating foundation's displacements are reported against
+/// (`problem::foundation::free_field::Frame`: the one reference of every foundation model).
+#[derive(Clone, Copy)]
+pub struct FreeFieldRef<'a> {
+    pub field: &'a FreeField,
+    pub frame: &'a Frame,
+}
+
+impl FreeFieldRef<'_> {
+    fn displacement(&self, node: usize, t: f64) -> [f64; 3] {
+        self.frame.displacement(self.field, node, t)
+    }
+}
+
 /// Everything a run writes: frames, histories, joint series, peaks, progress.
 pub struct Recorder {
     pub out_dir: PathBuf,
@@ -267,6 +288,8 @@ pub struct Recorder {
     joints: Option<JointWriter>,
     envelope: Option<EnvelopeWriter>,
     pub peaks: Peaks,
+    /// The free-field frame of a radiating foundation (displacements reported relative to it).
+    free_field: Option<Frame>,
     frame_stride: usize,
     hist_stride: usize,
     rows: Vec<[f64; 9]>,
@@ -317,6 +340,7 @@ impl Recorder {
             joints,
             envelope,
             peaks: Peaks::default(),
+            free_field: p.far_boundary.as_ref().map(|f| Frame::new(&f.free_field, model.mesh.nodes.iter().map(|x| x[2]))),
             frame_stride,
             hist_stride: history_stride(&scene.output, dt, scene.time.duration),
             rows,
@@ -325,12 +349,13 @@ impl Recorder {
         })
     }
 
-    /// The monitors' rows [u; v; a] at `kin`.
-    fn monitor_rows(&mut self, kin: &Kinematics<'_>) {
+    /// The monitors' rows [u; v; a] at `kin`, u relative to `reference` when given.
+    fn monitor_rows(&mut self, kin: &Kinematics<'_>, reference: Option<FreeFieldRef<'_>>) {
         for (r, m) in self.rows.iter_mut().zip(&self.monitors) {
+            let u0 = reference.map(|f| f.displacement(m.node, kin.t)).unwrap_or([0.0; 3]);
             for c in 0..3 {
                 let i = 3 * m.node + c;
-                r[c] = kin.u[i];
+                r[c] = kin.u[i] - u0[c];
                 r[3 + c] = kin.velocity(i);
                 r[6 + c] = kin.acceleration(i);
             }
@@ -539,8 +564,11 @@ impl Observer for Recorder {
         let last = self.stop.map_or(last, |s| s.min(last));
         // the step just taken gives u[k−1], u[k], u[k+1]: the volume and monitors at t[k]
         let kin = Kinematics { t: k as f64 * dt, ..sim.kinematics() };
+        // the frame taken out while its reference is lent to the monitors and the peaks
+        let frame = self.free_field.take();
+        let reference = p.far_boundary.as_ref().zip(frame.as_ref()).map(|(f, frame)| FreeFieldRef { field: &f.free_field, frame });
         if self.history_due(k, last) {
-            self.monitor_rows(&kin);
+            self.monitor_rows(&kin, reference);
             self.history.row(kin.t, &self.rows);
         }
         if let Some(e) = self.envelope.as_mut() {
@@ -549,8 +577,9 @@ impl Observer for Recorder {
             }
         }
         if k % PEAK_STRIDE == 0 || k == last {
-            self.peaks.update(&p.model, &kin);
+            self.peaks.update(&p.model, &kin, reference);
         }
+        self.free_field = frame;
         if self.frame_due(k, last) {
             if let Some(f) = self.frames.as_mut() {
                 f.write(&p.model, &kin)?;

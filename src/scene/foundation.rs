@@ -37,6 +37,38 @@ impl FoundationModel {
     }
 }
 
+/// The massed rock's Rayleigh damping, a group of its own (issue 29 §3; docs/dam_physics.md
+/// "Foundation models"). The explicit step applies one pair (α, β) of the scene's `damping`:
+/// βK on every element, αM on the nodes of `damping.mass_groups`; the rock's choice is whether
+/// its nodes carry αM.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RockDamping {
+    /// The scene's Rayleigh pair on the rock as on the dam (its volume groups join
+    /// `damping.mass_groups`). Default. Why: with βK alone the dam study's β = 3.0e-5 s (5 % at
+    /// 1.5 and 526 Hz) damps the rock by ξ = βω/2 = 0.01 % at 1 Hz, and a rock box ringing at
+    /// its first modes (c_s / 4D: 1.3 Hz under the valley floor, 0.9 Hz under the plateaus of
+    /// the default dam) next to the dam's f1 (0.85–1.1 Hz) is then undamped: the massed_fixed
+    /// run of the last `make dam` grew to 8.2 m at the crest (docs/dam_physics.md). The dam's
+    /// ratio (5 % at 1.5 Hz, 6–7.5 % at 1 Hz with α = 0.94 1/s) is the one damping of the whole
+    /// dam–rock system, as the seed's single ratio intends.
+    #[default]
+    AsDam,
+    /// βK only, the rock left out of αM (the state before this option; a lower bound of the
+    /// rock's damping). Needs `damping.mass_groups` naming the dam's groups (otherwise every
+    /// node carries αM and the rock cannot be left out).
+    StiffnessOnly,
+}
+
+impl RockDamping {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            RockDamping::AsDam => "as_dam",
+            RockDamping::StiffnessOnly => "stiffness_only",
+        }
+    }
+}
+
 /// `foundation` of a scene (field docs: docs/scenes.md).
 #[derive(Clone, Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -73,6 +105,10 @@ pub struct FoundationScene {
     /// model and only the dam's loads strain the rock.
     #[serde(default)]
     pub rock_weight: bool,
+    /// The massed rock's damping ([`RockDamping`]): "as_dam" (default) or "stiffness_only".
+    /// Nothing for the massless rock (condensed statically: no velocity to damp).
+    #[serde(default)]
+    pub damping: RockDamping,
 }
 
 fn default_far() -> Vec<String> {
@@ -81,7 +117,7 @@ fn default_far() -> Vec<String> {
 
 impl Default for FoundationScene {
     fn default() -> Self {
-        FoundationScene { model: FoundationModel::Massless, rock: None, far: default_far(), springs: false, spring_distance: None, surface: None, max_frequency: None, rock_weight: false }
+        FoundationScene { model: FoundationModel::Massless, rock: None, far: default_far(), springs: false, spring_distance: None, surface: None, max_frequency: None, rock_weight: false, damping: RockDamping::AsDam }
     }
 }
 
@@ -114,6 +150,9 @@ impl FoundationScene {
             }
             Ok(())
         };
+        if self.damping != RockDamping::AsDam && !self.model.massed() {
+            return Err(format!("foundation.damping \"{}\": only with a massed rock (\"massed_fixed\" or \"radiating\"; the model is \"{}\")", self.damping.as_str(), self.model.as_str()));
+        }
         radiating_only(self.springs, "springs")?;
         radiating_only(self.spring_distance.is_some(), "spring_distance")?;
         radiating_only(self.surface.is_some(), "surface")?;

@@ -180,3 +180,28 @@ fn realign(mut c: ColumnField, delay: f64) -> ColumnField {
     }
     c
 }
+
+/// The frame every reported displacement is measured in (docs/dam_physics.md "Foundation
+/// models", "Displacement reference"): the free field. The massless and massed_fixed models
+/// integrate displacements relative to the rigid base motion, which is their free field at every
+/// depth; the radiating model integrates total displacements, so its peaks and monitor
+/// displacements have the 1-D free field at each node's elevation taken off (the surface one
+/// above the rock, the dam's nodes). Without that, a radiating run reports the record's own
+/// ground displacement (the DL 5073 records at 3×: up to 2.1 m by 6 s, drift included) as the
+/// dam's motion. Velocities and accelerations are left as integrated.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    weights: Vec<DepthWeight>,
+}
+
+impl Frame {
+    /// The depth weights of every mesh node (`elevations`: the nodes' z [m]).
+    pub fn new(field: &FreeField, elevations: impl Iterator<Item = f64>) -> Frame {
+        Frame { weights: elevations.map(|z| field.depth_weight(z)).collect() }
+    }
+
+    /// The free-field displacement [m] of `node` at time `t` [s] of the run.
+    pub fn displacement(&self, field: &FreeField, node: usize, t: f64) -> [f64; 3] {
+        field.at(self.weights[node], t).disp
+    }
+}

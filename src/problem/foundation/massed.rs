@@ -18,20 +18,66 @@ use crate::error::{Error, ModelError};
 use crate::mesh::pattern::{is_pattern, GroupPattern};
 use crate::mesh::Mesh;
 use crate::model::Model;
-use crate::scene::foundation::{FoundationModel, FoundationScene};
+use crate::scene::foundation::{FoundationModel, FoundationScene, RockDamping};
 use crate::scene::Scene;
 
 /// The scene as the model is built: with a massed foundation, the rock's materials massed (and
-/// `foundation.rock` set to them).
+/// `foundation.rock` set to them), and with `foundation.damping` "as_dam" the rock's groups
+/// added to `damping.mass_groups` (when it names groups: otherwise every node carries αM).
 pub fn scene_for_model(mut scene: Scene) -> Scene {
     let Some(f) = scene.foundation.as_mut().filter(|f| f.model.massed()) else { return scene };
     let rock: Vec<String> = f.rock_materials(&scene.materials).iter().map(|m| m.group.clone()).collect();
     // the rock named explicitly: its materials are no longer marked massless
     f.rock = Some(rock.clone());
+    let damping = f.damping;
     for m in scene.materials.iter_mut().filter(|m| rock.contains(&m.group)) {
         m.massless = false;
     }
+    if let (RockDamping::AsDam, Some(groups)) = (damping, scene.damping.mass_groups.as_mut()) {
+        for g in &rock {
+            if !groups.contains(g) {
+                groups.push(g.clone());
+            }
+        }
+    }
     scene
+}
+
+/// The massed rock's own stable step: the largest ω²_max of its elements (element eigenvalue
+/// bound, lumped mass, no mass scaling) and that element's tag; (0, 0) for a rock without elements.
+fn rock_critical(model: &Model, rock_groups: &[String]) -> (f64, u64) {
+    let is_rock: Vec<bool> = model.materials.iter().map(|m| rock_groups.contains(&m.group) && m.rho > 0.0).collect();
+    let mut best = (0.0f64, 0u64);
+    for (e, g) in model.tets.geom.iter().enumerate() {
+        let mi = model.tets.mat[e] as usize;
+        if is_rock[mi] {
+            let m = &model.materials[mi];
+            let w2 = crate::model::tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame);
+            if w2 > best.0 {
+                best = (w2, model.mesh.cells[model.tets.cell[e] as usize].tag);
+            }
+        }
+    }
+    for (e, &si) in model.hexes.shape.iter().enumerate() {
+        let mi = model.hexes.mat[e] as usize;
+        if is_rock[mi] {
+            let m = &model.materials[mi];
+            let w2 = crate::model::hex8::max_eigenvalue(&model.hexes.shapes[si as usize], m.rho, &m.lame);
+            if w2 > best.0 {
+                best = (w2, model.mesh.cells[model.hexes.cell[e] as usize].tag);
+            }
+        }
+    }
+    best
+}
+
+/// The central-difference stable step at ω² `w2` with Rayleigh α, β (as [`Model::stable_dt`]).
+fn stable_step(w2: f64, alpha: f64, beta: f64) -> f64 {
+    if w2 <= 0.0 {
+        return f64::INFINITY;
+    }
+    let c = alpha + beta * w2;
+    (-c + (c * c + 4.0 * w2).sqrt()) / w2
 }
 
 /// The far face groups: `far`'s names and patterns matched against the mesh's face groups.
@@ -92,15 +138,26 @@ pub fn prepare_loads(scene: &Scene, model: &Model, loads: &mut Loads, notes: &mu
         }
         loads.gravity_nodes = Some(mask);
     }
+    if f.damping == RockDamping::StiffnessOnly && scene.damping.mass_groups.is_none() && model.alpha > 0.0 {
+        return Err(ModelError::Invalid("foundation.damping \"stiffness_only\": damping.mass_groups names no groups, so every node (the rock's too) carries αM; name the dam's volume groups there".into()).into());
+    }
     let c = &model.critical;
+    let groups: Vec<String> = f.rock_materials(&scene.materials).iter().map(|m| m.group.clone()).collect();
+    let damped = rock.nodes.first().is_some_and(|&n| model.mass_damped[n]);
+    let alpha = if damped { model.alpha } else { 0.0 };
+    let (w2, tag) = rock_critical(model, &groups);
     notes.push(format!(
-        "foundation {}: rock massed ({} nodes, ρ {} kg/m³, c_p {:.0} m/s, c_s {:.0} m/s){}; stable step of the elements {:.4e} s, set by element {} in \"{}\"",
+        "foundation {}: rock massed ({} nodes, ρ {} kg/m³, c_p {:.0} m/s, c_s {:.0} m/s){}; rock damping {} (α {alpha:.4} 1/s, β {:.3e} s: ξ {:.2} % at 1 Hz); the rock's own stable step {:.4e} s, set by its element {tag}; stable step of all elements {:.4e} s, set by element {} in \"{}\"",
         f.model.as_str(),
         rock.nodes.len(),
         rock.material.rho,
         rock.material.wave_speed(),
         (rock.material.lame.mu / rock.material.rho).sqrt(),
         if f.rock_weight { ", with its weight" } else { ", weightless (in-situ state predates the dam)" },
+        f.damping.as_str(),
+        model.beta,
+        100.0 * (alpha / (4.0 * std::f64::consts::PI) + model.beta * std::f64::consts::PI),
+        stable_step(w2, alpha, model.beta),
         model.stable_dt(),
         c.tag,
         c.group

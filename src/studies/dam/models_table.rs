@@ -74,9 +74,10 @@ pub fn model_rows(r: &DamReport) -> Vec<ModelRow> {
         let (t, u): (Vec<f64>, Vec<f64>) = run.crown_x.iter().copied().unzip();
         fit_free_decay(&t, &u, pp.start, pp.band[0], pp.band[1], 2)
     };
+    // the empty reservoir's rows too: their f1 and ξ1 are the dam's own on each rock (no
+    // earthquake run: their level cells are –)
     let mut rows: Vec<ModelRow> = keys
         .iter()
-        .filter(|(res, _)| res != "empty")
         .map(|(res, fnd)| {
             let decay = fit(res, fnd);
             let empty = fit("empty", fnd).and_then(|d| d.modes.first().map(|m| m.frequency));
@@ -171,7 +172,7 @@ pub fn models_table_section(r: &DamReport, doc: &mut Doc) {
     let _ = writeln!(md, "{}\n", headline(&rows, &levels));
     let _ = writeln!(
         md,
-        "Main mesh, NTS joints. f1 and ξ1: the first mode's frequency and damping ratio, fitted to the crown's cross-stream motion in free vibration after a cross-stream pulse (joints bonded; two damped modes by least squares, src/studies/dam/decay.rs); drop: 1 − f1 / f1 with the reservoir empty on the same rock. Per level: largest joint opening, largest net slip [mm], the faces' largest σ1 and most compressive σ3 [MPa]. – : no run.\n"
+        "Main mesh, NTS joints. f1 and ξ1: the first mode's frequency and damping ratio, fitted to the crown's cross-stream motion in free vibration after a cross-stream pulse (joints bonded; two damped modes by least squares, src/studies/dam/decay.rs); drop: 1 − f1 / f1 with the reservoir empty on the same rock. Per level: largest joint opening, largest net slip [mm], the faces' largest σ1 and most compressive σ3 [MPa]. – : no run. Displacements of every foundation model are relative to the free field (the rigid base motion for massless and massed_fixed; for radiating the 1-D free field at each node's elevation taken off its total motion). massed_fixed is the reflecting check: a closed rock box whose waves cannot leave, its numbers an upper bound, not a design model.\n"
     );
     let mut head = String::from("| reservoir | foundation | f1 [Hz] | drop [%] | ξ1 [%] |");
     let mut rule = String::from("|---|---|---|---|---|");
