@@ -31,6 +31,16 @@
 //! takes no force. Models without partly fixed nodes never enter this path (docs/contact.md,
 //! "Partly fixed nodes").
 //!
+//! **Threads.** The search runs in parallel over chunks of each joint's slave nodes (each pair
+//! writes only its own record; the chunks' active pairs are appended in the order one thread
+//! lists them, and the event counters are integer sums). The sweeps run each colour's pairs in
+//! parallel: two pairs of one colour share no moving node and a pair writes only its moving
+//! nodes, so a colour's pass gives the same positions in any order, and its pairs share one tick
+//! of the work list's clock (whether a pair is evaluated again depends only on the order of
+//! the colours' ticks). The result is bit-identical on any number of threads (test
+//! `contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread`). The mortar pairs,
+//! the last colour (pairs past 63 colours) and the set-up and record stay on one thread.
+//!
 //! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal spring
 //! kn A on the gap, tangential elastic spring kt A, with the joint law of the dynamic contact
 //! force ([`super::law::penalty_force`]: Mohr-Coulomb, cohesion, tension, tied), applied as an
@@ -46,6 +56,7 @@ use crate::constraint::{Constraint, ConstraintInfo, StepContext};
 use crate::error::StepError;
 use crate::model::Model;
 use nalgebra::{Matrix3, Vector2, Vector3};
+use rayon::prelude::*;
 
 /// The master side of one pair: up to four master nodes (`nm` used) with their weights `N_I`,
 /// and the master face (−1 for NTN).
@@ -164,10 +175,61 @@ struct MortarScratch {
     face_evaluations: u64,
 }
 
+/// A penalty pair's force of step n (`Method::Penalty`): slave node, master nodes, their count,
+/// weights and the force on the slave [N].
+type PenaltyPair = (u32, [u32; 4], u8, [f64; 4], Vector3<f64>);
+
+/// Pairs per task of a colour's parallel Gauss–Seidel pass: 128 (about 128 × 50 ns of updates
+/// against a task's hand-over of about 1 µs).
+const SWEEP_CHUNK: usize = 128;
+
+/// A slice that the threads of one parallel pass read and write at disjoint places: the pairs
+/// of one colour ([`ContactSolver::order_by_color`]) and the nodes they move. Two pairs of one
+/// colour share no moving node, a pair writes only its moving nodes (mobility ≠ 0), so no
+/// entry is written by one thread while another reads or writes it.
+#[derive(Clone, Copy)]
+struct Shared<T>(*mut T, usize);
+// SAFETY: the pointer is only dereferenced at entries that one thread alone writes (above).
+unsafe impl<T: Send> Send for Shared<T> {}
+unsafe impl<T: Send> Sync for Shared<T> {}
+
+impl<T: Copy> Shared<T> {
+    fn of(s: &mut [T]) -> Shared<T> {
+        Shared(s.as_mut_ptr(), s.len())
+    }
+
+    /// Entry `i` by value. SAFETY: `i` in bounds and no other thread writes it meanwhile.
+    #[inline(always)]
+    unsafe fn get(self, i: usize) -> T {
+        debug_assert!(i < self.1);
+        unsafe { *self.0.add(i) }
+    }
+
+    /// Entry `i` to write. SAFETY: `i` in bounds and no other thread reads or writes it while
+    /// the reference lives.
+    #[inline(always)]
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn at<'a>(self, i: usize) -> &'a mut T {
+        debug_assert!(i < self.1);
+        unsafe { &mut *self.0.add(i) }
+    }
+}
+
+/// One task of the search: its candidate-face scratch, and the active pairs (with their
+/// mobility matrices), penalty forces and search events of its slave nodes, gathered in task
+/// order after the parallel search.
+#[derive(Default)]
+struct SearchChunk {
+    active: Vec<Active>,
+    mob_matrix: Vec<[Matrix3<f64>; 5]>,
+    penalty: Vec<PenaltyPair>,
+    events: SearchEvents,
+    cand: Vec<u32>,
+}
+
 /// Slave node `i` found no master face this step: counted lost, force-free.
-fn lose_pair(rec: &mut JointRecord, i: usize) {
-    rec.events.lost += 1;
-    let p = &mut rec.pairs[i];
+fn lose_pair(p: &mut PairRecord, ev: &mut SearchEvents) {
+    ev.lost += 1;
     p.face = -1;
     p.gap = f64::NAN;
     p.r_n = 0.0;
@@ -177,8 +239,7 @@ fn lose_pair(rec: &mut JointRecord, i: usize) {
 
 /// Slave node `i`'s pair is not formed (`joint::unformed_pairs`: the tie fixes the node):
 /// reported bonded, with no force of its own.
-fn unform_pair(rec: &mut JointRecord, i: usize) {
-    let p = &mut rec.pairs[i];
+fn unform_pair(p: &mut PairRecord) {
     p.state = PairState::Bonded;
     p.r_n = 0.0;
     p.r_t = [0.0; 2];
@@ -187,7 +248,7 @@ fn unform_pair(rec: &mut JointRecord, i: usize) {
 /// The master side of slave node `i` projected at `p` on master face `f`; with `widen`, the
 /// node's candidate set is recentred on the face node it is nearest to (`report` keeps the
 /// initial set, by definition).
-fn masters_on_face(j: &ContactJoint, rec: &mut JointRecord, i: usize, f: usize, p: &super::query::Projection) -> PairMasters {
+fn masters_on_face(j: &ContactJoint, pr: &mut PairRecord, ev: &mut SearchEvents, f: usize, p: &super::query::Projection) -> PairMasters {
     let local = j.tag.master.faces[f].local_nodes();
     let (mut best, mut wmax) = (local[0], f64::MIN);
     for (a, &l) in local.iter().enumerate() {
@@ -196,16 +257,16 @@ fn masters_on_face(j: &ContactJoint, rec: &mut JointRecord, i: usize, f: usize, 
             best = l;
         }
     }
-    if j.on_exit == OnExit::Widen && rec.pairs[i].center != best {
-        rec.pairs[i].center = best;
-        rec.events.recentred += 1;
+    if j.on_exit == OnExit::Widen && pr.center != best {
+        pr.center = best;
+        ev.recentred += 1;
     }
     let nodes = j.tag.master.faces[f].nodes();
     let mut ms = [0u32; 4];
     for (a, &nd) in nodes.iter().enumerate() {
         ms[a] = nd;
     }
-    rec.pairs[i].xi = p.xi;
+    pr.xi = p.xi;
     PairMasters { nodes: ms, nm: nodes.len() as u8, weights: p.weights, face: f as i32 }
 }
 
@@ -294,9 +355,15 @@ impl<const N: usize> Active<N> {
     /// always: unused entries have coefficient 0).
     #[inline(always)]
     fn relative_displacement(&self, local: &[LocalNode]) -> Vector3<f64> {
+        self.relative_displacement_with(|l| local[l].x)
+    }
+
+    /// [`Self::relative_displacement`] with the local nodes' positions read by `x`.
+    #[inline(always)]
+    fn relative_displacement_with(&self, x: impl Fn(usize) -> Vector3<f64>) -> Vector3<f64> {
         let mut rel = Vector3::zeros();
         for b in 0..self.span() {
-            rel += local[self.local[b] as usize].x * self.coef[b];
+            rel += x(self.local[b] as usize) * self.coef[b];
         }
         rel
     }
@@ -366,7 +433,23 @@ pub struct ContactSolver<'m> {
     colors: Vec<u8>,
     /// The Gauss–Seidel order of the active pairs (indices into `active`).
     order: Vec<u32>,
-    penalty: Vec<(u32, [u32; 4], u8, [f64; 4], Vector3<f64>)>,
+    penalty: Vec<PenaltyPair>,
+    /// Per task of the search (a joint's slave nodes in chunks of `search_chunk`), its
+    /// scratch and results, kept between steps.
+    search_chunks: Vec<SearchChunk>,
+    /// Slave nodes per task of the parallel search. Default 256: the dam's joints (tens to
+    /// thousands of slave nodes each) then share out evenly over the threads, and a task
+    /// (about 256 × 0.3 µs) costs far more than its hand-over (about 1 µs). The result does not
+    /// depend on it (the tasks' pairs are gathered in the order of one thread).
+    pub search_chunk: usize,
+    /// Pairs of one colour below which the colour is swept on one thread. Default 256: a
+    /// smaller colour's pass (about 50 ns a pair) costs no more than waking the other threads.
+    /// The result does not depend on it (module doc, "Threads").
+    pub sweep_par_min: usize,
+    /// The colour runs of `order`: start, end, and whether the run is one colour (false: the
+    /// pairs in search order, or the last colour, which takes every pair past 63 colours and
+    /// may hold pairs that share a node); swept one after the other.
+    color_runs: Vec<(u32, u32, bool)>,
     /// Per node 1/m for the pair mobilities (0 at a fully fixed node or one without inertia; at
     /// a block node its largest inverse mass; a partly fixed node has its 1/m, applied to its
     /// free components only).
@@ -417,7 +500,7 @@ impl<'m> ContactSolver<'m> {
         }
         let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
-        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Slave faces whose mortar integrals were evaluated so far, all mortar joints together (the
@@ -486,6 +569,12 @@ impl<'m> ContactSolver<'m> {
         for c in 1..64 {
             start[c] = start[c - 1] + count[c - 1];
         }
+        self.color_runs.clear();
+        for c in 0..64 {
+            if count[c] > 0 {
+                self.color_runs.push((start[c] as u32, (start[c] + count[c]) as u32, c < 63));
+            }
+        }
         self.order.clear();
         self.order.resize(self.active.len(), 0);
         for (k, &c) in self.colors.iter().enumerate() {
@@ -494,24 +583,23 @@ impl<'m> ContactSolver<'m> {
         }
     }
 
-    fn candidates_into(&mut self, j: &ContactJoint, center: u32, layer: u8) {
-        self.cand.clear();
-        let m = &j.tag.master;
-        for &f in m.faces_of_node(center as usize) {
-            self.cand.push(f);
-        }
-        if layer >= 2 {
-            let l1 = self.cand.clone();
-            for f in l1 {
-                for &v in m.faces[f as usize].local_nodes() {
-                    for &g in m.faces_of_node(v as usize) {
-                        self.cand.push(g);
-                    }
-                }
+}
+
+/// The candidate master faces around master-local node `center` into `cand`: its faces
+/// (Layer1), with `layer` 2 also the faces of their nodes (Layer2), ascending.
+fn candidates_into(cand: &mut Vec<u32>, j: &ContactJoint, center: u32, layer: u8) {
+    cand.clear();
+    let m = &j.tag.master;
+    cand.extend_from_slice(m.faces_of_node(center as usize));
+    if layer >= 2 {
+        let n1 = cand.len();
+        for k in 0..n1 {
+            for &v in m.faces[cand[k] as usize].local_nodes() {
+                cand.extend_from_slice(m.faces_of_node(v as usize));
             }
-            self.cand.sort_unstable();
-            self.cand.dedup();
         }
+        cand.sort_unstable();
+        cand.dedup();
     }
 }
 
@@ -686,56 +774,101 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
     m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
+/// One Gauss–Seidel pass over the node-to-segment pairs, run by run of `color_runs` (indices
+/// into `order`): a run that is one colour gives all its pairs one tick of the clock and, with
+/// `parallel` and at least `par_min` pairs, is shared out over the threads in chunks of
+/// [`SWEEP_CHUNK`] pairs (of `par_min` when that is smaller, as in the tests); another run ticks per pair, on one thread. The same result on any number
+/// of threads (module doc, "Threads"). Returns what [`sweep_pass`] returns, summed.
+#[allow(clippy::too_many_arguments)]
+fn sweep_colors<const LISTED: bool>(active: &mut [Active], order: &[u32], color_runs: &[(u32, u32, bool)], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]], parallel: bool, par_min: usize) -> usize {
+    let (pa, pl, pe) = (Shared::of(active), Shared::of(local), Shared::of(evaluated_at));
+    let mut moving = 0;
+    for &(start, end, colour) in color_runs {
+        let run = &order[start as usize..end as usize];
+        if !colour {
+            // SAFETY: one thread
+            moving += unsafe { sweep_pass::<LISTED, 5>(pa, run, pl, pe, clock, true, laws, mark_tol2, mob_matrix) };
+            continue;
+        }
+        // One tick for the colour: its pairs share no moving node, so none of them moves a node
+        // of another, and whether a pair is evaluated again depends only on the ticks of the
+        // other colours, which keep their order.
+        *clock += LISTED as u32;
+        let tick = *clock;
+        let pass = |pairs: &[u32]| {
+            let mut t = tick;
+            // SAFETY: the pairs of one colour, each in one chunk: a pair and its moving nodes are
+            // written by the thread of its chunk alone, and the nodes two pairs of the colour
+            // share are fixed ones, which no pair writes (`update_pair`)
+            unsafe { sweep_pass::<LISTED, 5>(pa, pairs, pl, pe, &mut t, false, laws, mark_tol2, mob_matrix) }
+        };
+        moving += if parallel && run.len() >= par_min { run.par_chunks(SWEEP_CHUNK.min(par_min.max(1))).map(pass).sum::<usize>() } else { pass(run) };
+    }
+    moving
+}
+
 /// One Gauss–Seidel pass over the active pairs in `order` (see [`ContactSolver::sweep_into`]):
 /// with `LISTED`, only the pairs one of whose nodes moved since their last evaluation, stamping
-/// the nodes each update moves; without, every pair and no clocks. Returns how many pairs moved
-/// a node by more than the marking tolerance (counted without `LISTED` only). Two copies of the
-/// loop rather than a test per pair, so that the full pass carries nothing of the list.
+/// the nodes each update moves at `clock` (advanced per pair with `tick_per_pair`); without,
+/// every pair and no clocks. Returns how many pairs moved a node by more than the marking
+/// tolerance (counted without `LISTED` only). Two copies of the loop rather than a test per
+/// pair, so that the full pass carries nothing of the list.
+///
+/// SAFETY: no other thread reads or writes the pairs in `order` or their moving nodes, nor
+/// writes their other nodes, while the pass runs ([`Shared`]).
 #[inline(never)] // its own code, whatever the code around it (a sweep is long; one call per sweep)
 #[allow(clippy::too_many_arguments)]
-fn sweep_pass<const LISTED: bool, const N: usize>(active: &mut [Active<N>], order: &[u32], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; N]]) -> usize {
+unsafe fn sweep_pass<const LISTED: bool, const N: usize>(active: Shared<Active<N>>, order: &[u32], local: Shared<LocalNode>, evaluated_at: Shared<u32>, clock: &mut u32, tick_per_pair: bool, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; N]]) -> usize {
     let mut moving = 0;
     for &k in order.iter() {
         let k = k as usize;
-        let a = &active[k];
+        // SAFETY: pair k is this pass's alone (the function's contract)
+        let a = unsafe { active.at(k) };
         if LISTED {
-            if !moved_since(local, a, evaluated_at[k]) {
+            // SAFETY: as above
+            let e = unsafe { evaluated_at.at(k) };
+            if !moved_since_with(a, *e, |l| unsafe { local.get(l).moved_at }) {
                 continue;
             }
-            *clock += 1;
-            evaluated_at[k] = *clock;
+            *clock += tick_per_pair as u32;
+            *e = *clock;
         }
+        // SAFETY (the updates): the contract, passed on
         if a.partial {
             // a pair with a partly fixed node repeats its update (its scalar mobility is an
             // upper bound of its directions', so one update may leave part of its own
             // residual: `PARTIAL_PAIR_UPDATES`), until an update moves no node
-            let moved = update_pair::<LISTED, true, N>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix);
+            let moved = unsafe { update_pair::<LISTED, true, N>(a, k, local, *clock, laws, mark_tol2, mob_matrix) };
             moving += moved as usize;
             if moved {
                 for _ in 1..PARTIAL_PAIR_UPDATES {
-                    if !update_pair::<LISTED, true, N>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) {
+                    if !unsafe { update_pair::<LISTED, true, N>(a, k, local, *clock, laws, mark_tol2, mob_matrix) } {
                         break;
                     }
                 }
             }
         } else {
-            moving += update_pair::<LISTED, false, N>(&mut active[k], k, local, *clock, laws, mark_tol2, mob_matrix) as usize;
+            moving += unsafe { update_pair::<LISTED, false, N>(a, k, local, *clock, laws, mark_tol2, mob_matrix) } as usize;
         }
     }
     if LISTED { 0 } else { moving }
 }
 
 /// One update of active pair `a` (index `k`) in a sweep: its force from the current positions
-/// of its local nodes with its own force removed, the nodes moved by the change, and with
-/// `LISTED` the nodes it moves by more than the marking tolerance stamped at `clock`. `PARTIAL`:
-/// the pair has a partly fixed node and moves its nodes by `mob_matrix[k]`. Returns whether the
-/// update moved a node by more than the marking tolerance.
+/// of its local nodes with its own force removed, its moving nodes moved by the change (a fixed
+/// node or an unused entry, mobility 0, is neither moved nor written), and with `LISTED` the
+/// nodes it moves by more than the marking tolerance stamped at `clock`. `PARTIAL`: the pair
+/// has a partly fixed node and moves its nodes by `mob_matrix[k]`. Returns whether the update
+/// moved a node by more than the marking tolerance.
+///
+/// SAFETY: no other thread writes the pair's nodes, or reads its moving ones, meanwhile.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn update_pair<const LISTED: bool, const PARTIAL: bool, const N: usize>(a: &mut Active<N>, k: usize, local: &mut [LocalNode], clock: u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; N]]) -> bool {
+unsafe fn update_pair<const LISTED: bool, const PARTIAL: bool, const N: usize>(a: &mut Active<N>, k: usize, local: Shared<LocalNode>, clock: u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; N]]) -> bool {
     let [n, t1, t2] = a.frame;
     // current relative quantities with all forces applied so far
-    let rel = a.relative_displacement(local);
+    // SAFETY: the pair's nodes, which no other thread writes (the contract)
+    let rel = a.relative_displacement_with(|l| unsafe { local.get(l).x });
     let g_cur = a.gap0 + n.dot(&rel);
     let dd = a.rel_u - rel;
     // remove the pair's own force: g = g̃ + dt²w r_n, Δd = Δd̃ + dt²w R
@@ -751,23 +884,19 @@ fn update_pair<const LISTED: bool, const PARTIAL: bool, const N: usize>(a: &mut 
     let dr = -n * d_rn + t1 * d_rt.x + t2 * d_rt.y;
     // |du|² = |dr|² mob²: one norm per pair instead of one per node
     let dr2 = dr.norm_squared();
-    if LISTED {
-        for b in 0..a.span() {
-            let l = &mut local[a.local[b] as usize];
+    for b in 0..a.span() {
+        if a.mob[b] == 0.0 {
+            continue;
+        }
+        // SAFETY: a moving node of this pair, no other thread's (the contract)
+        let l = unsafe { local.at(a.local[b] as usize) };
+        if LISTED {
             l.moved_at = l.moved_at.max(clock * (dr2 * (a.mob[b] * a.mob[b]) > mark_tol2) as u32);
-            if PARTIAL {
-                l.x += mob_matrix[k][b] * dr;
-            } else {
-                l.x += dr * a.mob[b];
-            }
         }
-    } else if PARTIAL {
-        for b in 0..a.span() {
-            local[a.local[b] as usize].x += mob_matrix[k][b] * dr;
-        }
-    } else {
-        for b in 0..a.span() {
-            local[a.local[b] as usize].x += dr * a.mob[b];
+        if PARTIAL {
+            l.x += mob_matrix[k][b] * dr;
+        } else {
+            l.x += dr * a.mob[b];
         }
     }
     a.gap = g_trial + a.dt2w * resp.r_n;
@@ -781,7 +910,13 @@ fn update_pair<const LISTED: bool, const PARTIAL: bool, const N: usize>(a: &mut 
 /// Whether active pair `a`, last evaluated at tick `since`, has a node moved after it.
 #[inline(always)]
 fn moved_since<const N: usize>(local: &[LocalNode], a: &Active<N>, since: u32) -> bool {
-    a.local[..a.span()].iter().fold(0, |m, &l| m.max(local[l as usize].moved_at)) > since
+    moved_since_with(a, since, |l| local[l].moved_at)
+}
+
+/// [`moved_since`] with the local nodes' ticks read by `moved_at`.
+#[inline(always)]
+fn moved_since_with<const N: usize>(a: &Active<N>, since: u32, moved_at: impl Fn(usize) -> u32) -> bool {
+    a.local[..a.span()].iter().fold(0, |m, &l| m.max(moved_at(l as usize))) > since
 }
 
 impl ContactSolver<'_> {
@@ -797,49 +932,91 @@ impl ContactSolver<'_> {
         self.penalty.clear();
         let joints = self.joints;
         for (ji, j) in joints.iter().enumerate() {
-            let rec = &mut history.joints[ji];
             if j.method == Method::Mortar {
-                self.mortar_search_into(model, j, ji, rec, dt2, u, u_next)?;
-                continue;
-            }
-            let penalty = matches!(j.method, Method::Penalty { .. });
-            // penalty works on the configuration at t[n]; the dynamic force on the prediction
-            let conf: &[f64] = if penalty { u } else { u_next };
-            for i in 0..j.tag.n_slave() {
-                let s = j.tag.slave_nodes()[i];
-                let xs = pos(model, conf, s);
-                let pm = match j.method {
-                    Method::Ntn => PairMasters { nodes: [j.tag.nearest_master_node(i) as u32, 0, 0, 0], nm: 1, weights: [1.0, 0.0, 0.0, 0.0], face: -1 },
-                    _ => match self.nts_face_into(model, j, rec, i, &xs, conf) {
-                        Some((f, p)) => masters_on_face(j, rec, i, f, &p),
-                        None => {
-                            lose_pair(rec, i);
-                            // beyond the master's free edge (expected) or lost inside it
-                            self.candidates_into(j, rec.pairs[i].center, 2);
-                            let near = free_edge::outline_faces(&j.tag.master, &self.cand, |g| pos(model, conf, g));
-                            let beyond = free_edge::lost_where(&near, &xs, &j.frames[i][0]) == free_edge::LostWhere::BeyondFreeEdge;
-                            rec.pairs[i].beyond_edge = beyond;
-                            rec.events.lost_beyond_edge += u64::from(beyond);
-                            continue;
-                        }
-                    },
-                };
-                // A pair whose slave node is the slave of a (later) tied joint is not formed
-                // (`joint::unformed_pairs`: the tie fixes the node): reported bonded, with no
-                // force of its own.
-                if self.unformed[ji][i] {
-                    unform_pair(rec, i);
-                    continue;
-                }
-                let Some(mobility) = self.pair_mobility(model, s, &j.frames[i][0], &pm) else { continue };
-                if let Method::Penalty { kn, kt } = j.method {
-                    self.penalty_pair_into(model, j, rec, i, &pm, (kn, kt), &xs, u_prev, u);
-                } else {
-                    self.active_pair_into(model, j, ji, rec, i, &pm, &mobility, dt2, u);
-                }
+                self.mortar_search_into(model, j, ji, &mut history.joints[ji], dt2, u, u_next)?;
             }
         }
+        // the other joints in chunks of slave nodes, in parallel; each chunk's pairs are
+        // appended in the order of the joints and of their slave nodes, as one thread would
+        // list them (the pairs are independent in the search: each writes its own record)
+        let mut chunks = std::mem::take(&mut self.search_chunks);
+        let mut tasks: Vec<(usize, usize, &mut [PairRecord])> = Vec::new();
+        let chunk = self.search_chunk.max(1);
+        for (ji, rec) in history.joints.iter_mut().enumerate() {
+            if joints[ji].method != Method::Mortar {
+                tasks.extend(rec.pairs.chunks_mut(chunk).enumerate().map(|(c, pairs)| (ji, c * chunk, pairs)));
+            }
+        }
+        if chunks.len() < tasks.len() {
+            chunks.resize_with(tasks.len(), SearchChunk::default);
+        }
+        let task_joints: Vec<usize> = tasks.iter().map(|t| t.0).collect();
+        let this = &*self;
+        let prediction: &[f64] = u_next;
+        let search = |(ji, first, pairs): &mut (usize, usize, &mut [PairRecord]), out: &mut SearchChunk| this.search_chunk_into(model, *ji, *first, pairs, out, dt2, u_prev, u, prediction);
+        if rayon::current_num_threads() > 1 {
+            tasks.par_iter_mut().zip(chunks.par_iter_mut()).for_each(|(t, out)| search(t, out));
+        } else {
+            tasks.iter_mut().zip(chunks.iter_mut()).for_each(|(t, out)| search(t, out));
+        }
+        for (out, &ji) in chunks.iter_mut().zip(&task_joints) {
+            self.active.append(&mut out.active);
+            self.mob_matrix.append(&mut out.mob_matrix);
+            self.penalty.append(&mut out.penalty);
+            history.joints[ji].events.add(&out.events);
+            out.events = SearchEvents::default();
+        }
+        self.search_chunks = chunks;
         Ok(self.apply_penalty_into(model, dt2, u_prev, u_next))
+    }
+
+    /// The search of slave nodes `first..first + pairs.len()` of joint `ji` (not a mortar joint),
+    /// whose records are `pairs`: their active pairs, mobility matrices, penalty forces and
+    /// search events into `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn search_chunk_into(&self, model: &Model, ji: usize, first: usize, pairs: &mut [PairRecord], out: &mut SearchChunk, dt2: f64, u_prev: &[f64], u: &[f64], u_next: &[f64]) {
+        let j = &self.joints[ji];
+        let SearchChunk { active, mob_matrix, penalty, events: ev, cand } = out;
+        // penalty works on the configuration at t[n]; the dynamic force on the prediction
+        let conf: &[f64] = if matches!(j.method, Method::Penalty { .. }) { u } else { u_next };
+        for (k, pr) in pairs.iter_mut().enumerate() {
+            let i = first + k;
+            let s = j.tag.slave_nodes()[i];
+            let xs = pos(model, conf, s);
+            let pm = match j.method {
+                Method::Ntn => PairMasters { nodes: [j.tag.nearest_master_node(i) as u32, 0, 0, 0], nm: 1, weights: [1.0, 0.0, 0.0, 0.0], face: -1 },
+                _ => match Self::nts_face_into(model, j, pr, ev, cand, i, &xs, conf) {
+                    Some((f, p)) => masters_on_face(j, pr, ev, f, &p),
+                    None => {
+                        lose_pair(pr, ev);
+                        // beyond the master's free edge (expected) or lost inside it
+                        candidates_into(cand, j, pr.center, 2);
+                        let near = free_edge::outline_faces(&j.tag.master, cand, |g| pos(model, conf, g));
+                        let beyond = free_edge::lost_where(&near, &xs, &j.frames[i][0]) == free_edge::LostWhere::BeyondFreeEdge;
+                        pr.beyond_edge = beyond;
+                        ev.lost_beyond_edge += u64::from(beyond);
+                        continue;
+                    }
+                },
+            };
+            // A pair whose slave node is the slave of a (later) tied joint is not formed
+            // (`joint::unformed_pairs`: the tie fixes the node): reported bonded, with no
+            // force of its own.
+            if self.unformed[ji][i] {
+                unform_pair(pr);
+                continue;
+            }
+            let Some(mobility) = self.pair_mobility(model, s, &j.frames[i][0], &pm) else { continue };
+            if let Method::Penalty { kn, kt } = j.method {
+                penalty.push(self.penalty_pair_into(model, j, pr, i, &pm, (kn, kt), &xs, u_prev, u));
+            } else {
+                // a dynamic-force pair, warm-started from its force of the last step
+                let (a, matrix) = self.active_pair(model, j, ji, pr, i, &pm, &mobility, dt2, u, j.tag.areas[i]);
+                active.push(a);
+                mob_matrix.extend(matrix);
+                pr.face = pm.face;
+            }
+        }
     }
 
     /// The mortar pairs of joint `j` (`Method::Mortar`) on the prediction `u_next`
@@ -866,13 +1043,13 @@ impl ContactSolver<'_> {
         let ms = &j.tag.master;
         for i in 0..n_s {
             if self.unformed[ji][i] {
-                unform_pair(rec, i);
+                unform_pair(&mut rec.pairs[i]);
                 continue;
             }
             let (ml, mv, cnt) = mj.rows[i];
             let di = mj.d[i];
             if !(di >= MORTAR_MIN_COVER * j.tag.areas[i]) {
-                lose_pair(rec, i);
+                lose_pair(&mut rec.pairs[i], &mut rec.events);
                 continue;
             }
             let mut pm = PairMasters::<MORTAR_MASTERS> { nodes: [0; MORTAR_MASTERS], nm: cnt, weights: [0.0; MORTAR_MASTERS], face: -1 };
@@ -998,7 +1175,7 @@ impl ContactSolver<'_> {
             fi.size = sf.plane_area.sqrt();
             cand.clear();
             for &l in face.local_nodes() {
-                self.candidates_into(j, rec.pairs[l as usize].center, 2);
+                candidates_into(&mut self.cand, j, rec.pairs[l as usize].center, 2);
                 cand.extend_from_slice(&self.cand);
             }
             cand.sort_unstable();
@@ -1046,9 +1223,10 @@ impl ContactSolver<'_> {
     /// face of the last step when the node is still inside it, else its candidate set, the
     /// master's free edge within `edge_tolerance`, and with `widen` Layer2 and a fresh
     /// nearest-node search (module doc). `None`: the node found no face.
-    fn nts_face_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
+    #[allow(clippy::too_many_arguments)]
+    fn nts_face_into(model: &Model, j: &ContactJoint, rec: &mut PairRecord, ev: &mut SearchEvents, cand: &mut Vec<u32>, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
         let n = j.frames[i][0];
-        let pr = rec.pairs[i];
+        let pr = *rec;
         // Temporal coherence: a node still strictly inside the face it was on at
         // the last step, and near it along its normal (within half the face
         // size, so that no other sheet of a folded master can be nearer), keeps
@@ -1063,10 +1241,10 @@ impl ContactSolver<'_> {
             // edge in the prediction is not lost (regression:
             // `tied_pure_shear_keeps_perimeter_nodes_at_the_default_edge_tolerance`).
             let f = pr.face as usize;
-            found = project_on_face(model, j, f, xs, &n, conf, &mut rec.events.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
+            found = project_on_face(model, j, f, xs, &n, conf, &mut ev.projection_failures, f64::INFINITY, pr.xi).map(|(p, _)| (f, p));
         } else if pr.face >= 0 {
             let f = pr.face as usize;
-            if let Some((p, edge2)) = project_on_face(model, j, f, xs, &n, conf, &mut rec.events.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
+            if let Some((p, edge2)) = project_on_face(model, j, f, xs, &n, conf, &mut ev.projection_failures, INSIDE_TOL_DEFAULT, pr.xi)
                 && p.location == Location::Inside
                 && p.t * p.t <= 0.25 * edge2
             {
@@ -1074,42 +1252,34 @@ impl ContactSolver<'_> {
             }
         }
         if found.is_none() {
-            self.candidates_into(j, pr.center, j.layer);
-            found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+            candidates_into(cand, j, pr.center, j.layer);
+            found = project_on(model, j, cand, xs, &n, conf, &mut ev.projection_failures, INSIDE_TOL_DEFAULT);
         }
         if found.is_none() {
             // a node just off the master's free edge (see `edge_tolerance`)
-            found = self.project_on_candidates(model, j, rec, xs, &n, conf, j.edge_tolerance);
+            found = project_on(model, j, cand, xs, &n, conf, &mut ev.projection_failures, j.edge_tolerance);
             if found.is_some() {
-                rec.events.perimeter_kept += 1;
+                ev.perimeter_kept += 1;
             }
         }
         if found.is_none() && j.on_exit == OnExit::Widen {
-            found = self.widen_into(model, j, rec, i, xs, conf);
+            found = Self::widen_into(model, j, rec, ev, cand, i, xs, conf);
         }
-        found
-    }
-
-    /// Project on the candidate faces in `cand` (tolerance `tol`).
-    #[allow(clippy::too_many_arguments)]
-    fn project_on_candidates(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, xs: &Vector3<f64>, n: &Vector3<f64>, conf: &[f64], tol: f64) -> Option<(usize, super::query::Projection)> {
-        let cand = std::mem::take(&mut self.cand);
-        let found = project_on(model, j, &cand, xs, n, conf, &mut rec.events.projection_failures, tol);
-        self.cand = cand;
         found
     }
 
     /// `widen` (slave node `i` left its candidate set): Layer2 around the centre, then a walk on
     /// the master surface to the node nearest the slave's position, which becomes the centre.
-    fn widen_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
+    #[allow(clippy::too_many_arguments)]
+    fn widen_into(model: &Model, j: &ContactJoint, rec: &mut PairRecord, ev: &mut SearchEvents, cand: &mut Vec<u32>, i: usize, xs: &Vector3<f64>, conf: &[f64]) -> Option<(usize, super::query::Projection)> {
         let n = j.frames[i][0];
-        let pr = rec.pairs[i];
+        let pr = *rec;
         let mut found = None;
         if j.layer < 2 {
-            self.candidates_into(j, pr.center, 2);
-            found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+            candidates_into(cand, j, pr.center, 2);
+            found = project_on(model, j, cand, xs, &n, conf, &mut ev.projection_failures, INSIDE_TOL_DEFAULT);
             if found.is_some() {
-                rec.events.widened_layer2 += 1;
+                ev.widened_layer2 += 1;
             }
         }
         if found.is_none() {
@@ -1132,15 +1302,15 @@ impl ContactSolver<'_> {
                 }
                 c = best.1;
             }
-            rec.events.fresh_searches += 1;
-            rec.pairs[i].center = c as u32;
+            ev.fresh_searches += 1;
+            rec.center = c as u32;
             // Layer2 around the new centre; around the old one it was just
             // tried (above, or as the joint's own layer), with the same
             // result: a node that stays lost (outside the master, next to
             // its edge) costs one Layer2 search a step, not two
             if c != pr.center as usize {
-                self.candidates_into(j, c as u32, 2);
-                found = self.project_on_candidates(model, j, rec, xs, &n, conf, INSIDE_TOL_DEFAULT);
+                candidates_into(cand, j, c as u32, 2);
+                found = project_on(model, j, cand, xs, &n, conf, &mut ev.projection_failures, INSIDE_TOL_DEFAULT);
             }
         }
         found
@@ -1185,7 +1355,7 @@ impl ContactSolver<'_> {
     /// A penalty pair (`Method::Penalty`): its force of step n from the configuration at t[n],
     /// recorded in the history and queued in `penalty` for the prediction.
     #[allow(clippy::too_many_arguments)]
-    fn penalty_pair_into(&mut self, model: &Model, j: &ContactJoint, rec: &mut JointRecord, i: usize, pm: &PairMasters, (kn, kt): (f64, f64), xs: &Vector3<f64>, u_prev: &[f64], u: &[f64]) {
+    fn penalty_pair_into(&self, model: &Model, j: &ContactJoint, p: &mut PairRecord, i: usize, pm: &PairMasters, (kn, kt): (f64, f64), xs: &Vector3<f64>, u_prev: &[f64], u: &[f64]) -> PenaltyPair {
         let (masters, nm, weights) = (pm.nodes, pm.nm, pm.weights);
         let s = j.tag.slave_nodes()[i];
         let [n, t1, t2] = j.frames[i];
@@ -1197,7 +1367,7 @@ impl ContactSolver<'_> {
             xbar += pos(model, u, mi) * weights[a];
             um_n += disp(u, mi) * weights[a];
         }
-        let gap = n.dot(&(xbar - xs)) - rec.pairs[i].gap_offset;
+        let gap = n.dot(&(xbar - xs)) - p.gap_offset;
         // explicit penalty at t[n]: tangential increment over the last step
         let mut um_p = Vector3::zeros();
         for a in 0..nm as usize {
@@ -1205,7 +1375,6 @@ impl ContactSolver<'_> {
         }
         let dd = (disp(u, s) - um_n) - (disp(u_prev, s) - um_p);
         let area = j.tag.areas[i];
-        let p = &mut rec.pairs[i];
         let ddt = Vector2::new(dd.dot(&t1), dd.dot(&t2));
         let resp = penalty_force(&self.law_in_force(j), &p.hist, gap, Vector2::new(p.r_t[0], p.r_t[1]), ddt, kn * area, kt * area, area);
         p.hist = resp.hist;
@@ -1219,17 +1388,7 @@ impl ContactSolver<'_> {
         p.r_n = r_n;
         p.r_t = [r_t.x, r_t.y];
         p.state = state;
-        self.penalty.push((s as u32, masters, nm, weights, rvec));
-    }
-
-    /// A dynamic-force pair into the active list (`active`, and `mob_matrix` when the model has
-    /// partly fixed or block nodes), warm-started from its force of the last step.
-    #[allow(clippy::too_many_arguments)]
-    fn active_pair_into(&mut self, model: &Model, j: &ContactJoint, ji: usize, rec: &mut JointRecord, i: usize, pm: &PairMasters, mob_of: &Mobility, dt2: f64, u: &[f64]) {
-        let (a, matrix) = self.active_pair(model, j, ji, &rec.pairs[i], i, pm, mob_of, dt2, u, j.tag.areas[i]);
-        self.active.push(a);
-        self.mob_matrix.extend(matrix);
-        rec.pairs[i].face = pm.face;
+        (s as u32, masters, nm, weights, rvec)
     }
 
     /// A dynamic-force pair of slave node `i` (history `pr`) with the masters `pm`, its
@@ -1374,6 +1533,8 @@ impl ContactSolver<'_> {
         } else {
             self.order.clear();
             self.order.extend(0..self.active.len() as u32);
+            self.color_runs.clear();
+            self.color_runs.push((0, self.active.len() as u32, false));
         }
         // mortar pairs: in the order of the search, after the node-to-segment pairs
         self.mortar.order.clear();
@@ -1396,7 +1557,8 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_matrix, mortar, .. } = self;
+        let ContactSolver { active, order, color_runs, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_matrix, mortar, sweep_par_min, .. } = self;
+        let parallel = rayon::current_num_threads() > 1;
         let mut sweeps = 0;
         let pairs = active.len() + mortar.active.len();
         let mut converged = pairs == 0;
@@ -1427,13 +1589,23 @@ impl ContactSolver<'_> {
                 clock += 1;
                 local.iter_mut().for_each(|l| l.moved_at = clock);
             }
+            // the node-to-segment pairs by colour, then the mortar pairs in search order
             moving = if listed {
-                sweep_pass::<true, 5>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
-                    + sweep_pass::<true, MORTAR_NODES>(&mut m.active, &m.order, local, &mut m.evaluated_at, &mut clock, &laws, mark_tol2, &m.mob_matrix)
+                sweep_colors::<true>(active, order, color_runs, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix, parallel, *sweep_par_min)
             } else {
-                sweep_pass::<false, 5>(active, order, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix)
-                    + sweep_pass::<false, MORTAR_NODES>(&mut m.active, &m.order, local, &mut m.evaluated_at, &mut clock, &laws, mark_tol2, &m.mob_matrix)
+                sweep_colors::<false>(active, order, color_runs, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix, parallel, *sweep_par_min)
             };
+            if !m.active.is_empty() {
+                let (pa, pl, pe) = (Shared::of(&mut m.active), Shared::of(local), Shared::of(&mut m.evaluated_at));
+                // SAFETY: one thread
+                moving += unsafe {
+                    if listed {
+                        sweep_pass::<true, MORTAR_NODES>(pa, &m.order, pl, pe, &mut clock, true, &laws, mark_tol2, &m.mob_matrix)
+                    } else {
+                        sweep_pass::<false, MORTAR_NODES>(pa, &m.order, pl, pe, &mut clock, true, &laws, mark_tol2, &m.mob_matrix)
+                    }
+                };
+            }
             let max_du = sweep_change_into(local, sweep_start).sqrt();
             residual = max_du;
             converged = max_du <= *gs_tolerance

@@ -58,6 +58,21 @@ pub struct SearchEvents {
 }
 
 
+impl SearchEvents {
+    /// Add the counts of `o` (a part of the joint's slave nodes searched apart: the counts are
+    /// integers, so the sum does not depend on the order of the parts).
+    pub fn add(&mut self, o: &SearchEvents) {
+        self.widened_layer2 += o.widened_layer2;
+        self.fresh_searches += o.fresh_searches;
+        self.recentred += o.recentred;
+        self.lost += o.lost;
+        self.lost_beyond_edge += o.lost_beyond_edge;
+        self.projection_failures += o.projection_failures;
+        self.perimeter_kept += o.perimeter_kept;
+    }
+}
+
+
 /// Contact history of one joint.
 #[derive(Clone, Debug, Default)]
 pub struct JointRecord {
