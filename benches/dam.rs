@@ -36,7 +36,9 @@
 //! the process's CPU time per step (all threads; /proc/self/task/*/schedstat), which a load on
 //! the machine inflates far less than the wall time.
 //! Then the step with each reservoir model against Westergaard's (`reservoir_models`, knob
-//! `JQ_DAM_RESERVOIR`, default "coarse").
+//! `JQ_DAM_RESERVOIR`, default "coarse"). Then the static state (`static_state`, knob
+//! `JQ_DAM_STATIC`) and the static stages' fill with AMD and nested dissection (`static_fill`,
+//! knob `JQ_DAM_FILL`), both off by default.
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
 
 use jointquake::problem::foundation::CondensationMethod;
@@ -303,8 +305,8 @@ fn static_fill() -> Vec<serde_json::Value> {
     for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let (path, _) = static_scene(size);
         let cache = root().join("target/bench-mesh");
-        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|s| {
-            let mesh = jointquake::pipeline::load_mesh(&s, Some(&cache)).map_err(|e| e.to_string())?;
+        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
+            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
             jointquake::problem::Problem::build(s, mesh).map_err(|e| e.to_string())
         });
         let (k0, p) = match problem.map_err(|e| e.to_string()).and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {

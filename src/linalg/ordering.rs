@@ -1,8 +1,8 @@
 //! Fill-reducing orderings for [`SparseCholesky`](super::SparseCholesky): faer's approximate
 //! minimum degree (AMD, the default of small systems) or METIS's multilevel nested dissection
 //! (`METIS_NodeND`), which on the 3-D stiffness matrices of a dam gives a factor with fewer
-//! entries and fewer flops than AMD once the mesh has some ten thousand nodes
-//! (docs/performance.md §7b: the measured fill of both on the coarse, default and fine meshes).
+//! entries and fewer flops than AMD from some ten thousand nodes on (docs/performance.md §7b:
+//! the measured fill of both on the coarse, default, fine and h 2.5 m meshes).
 //!
 //! Conventions: a permutation is returned as `(forward, inverse)` with `forward[new] = old` and
 //! `inverse[old] = new`, faer's `PermRef` convention (row `new` of P A Pᵀ is row `forward[new]`
@@ -26,10 +26,13 @@ pub enum FillOrdering {
     Auto,
 }
 
-/// Unknowns from which [`FillOrdering::Auto`] takes nested dissection: 20 000. Why: on the
-/// coarse dam (10 623 unknowns) AMD's and METIS's factors are about the same size and AMD is
-/// computed in a fraction of METIS's time; from the default dam (30 741 unknowns) on, METIS's
-/// factor is smaller (docs/performance.md §7b).
+/// Unknowns from which [`FillOrdering::Auto`] takes nested dissection: 20 000. Why (measured
+/// factors of the dam's static stages, docs/performance.md §7b): on the coarse dam (10 623
+/// unknowns) AMD's factor of the stiffness is smaller (5 against 7 MB) and the preconditioner's
+/// about the same (18 against 16 MB); on the default dam (30 741) METIS's preconditioner factor
+/// needs 0.54× AMD's flops (76 against 101 MB) while the stiffness's is 13 % larger; on the
+/// fine dam (144 438) METIS's are smaller for both (298 against 339 MB, 754 against 1 217 MB,
+/// 0.40× the flops of the preconditioner's).
 pub const NESTED_DISSECTION_FROM: usize = 20_000;
 
 impl FillOrdering {
