@@ -37,7 +37,9 @@
 //! the process's CPU time per step (all threads; /proc/self/task/*/schedstat), which a load on
 //! the machine inflates far less than the wall time.
 //! Then the step with each reservoir model against Westergaard's (`reservoir_models`, knob
-//! `JQ_DAM_RESERVOIR`, default "coarse").
+//! `JQ_DAM_RESERVOIR`, default "coarse"). Then the static state (`static_state`, knob
+//! `JQ_DAM_STATIC`) and the static stages' fill with AMD and nested dissection (`static_fill`,
+//! knob `JQ_DAM_FILL`), both off by default.
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
 
 use jointquake::problem::foundation::CondensationMethod;
@@ -267,8 +269,73 @@ fn main() {
     });
     let reservoir = pool.install(|| reservoir_models(repeats, steps));
     let static_rows = static_state();
+    let fill_rows = static_fill();
     let _ = std::fs::create_dir_all(root().join("target/bench"));
-    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir, "static_state": static_rows})).unwrap());
+    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir, "static_state": static_rows, "static_fill": fill_rows})).unwrap());
+}
+
+/// The bench scene of the static state on mesh `size` (coarse, default, fine, h2.5): written
+/// into target/bench-static/dam_<size>.json; returns its path and JSON.
+fn static_scene(size: &str) -> (std::path::PathBuf, serde_json::Value) {
+    let set: serde_json::Value = match size {
+        "coarse" => serde_json::json!({"h": 20, "ht": 3.4, "hr": 40, "hrf": 200}),
+        "default" => serde_json::json!({}),
+        "fine" => serde_json::json!({"h": 5, "ht": 1.25, "hr": 12.5, "hrf": 80}),
+        "h2.5" => serde_json::json!({"h": 2.5, "ht": 0.625, "hr": 6.25, "hrf": 40}),
+        other => panic!("JQ_DAM_STATIC / JQ_DAM_FILL: unknown mesh \"{other}\" (coarse, default, fine, h2.5)"),
+    };
+    let text = std::fs::read_to_string(root().join("pipelines/dam.json")).expect("pipelines/dam.json");
+    let mut scene: serde_json::Value = serde_json::from_str(&text).expect("pipelines/dam.json is JSON");
+    scene["geometry"] = serde_json::json!({"geo": root().join("geo/arch_dam.geo"), "set": set});
+    for rec in scene["loads"]["base"].as_array_mut().into_iter().flatten() {
+        let r = root().join("pipelines").join(rec["record"].as_str().unwrap_or_default());
+        rec["record"] = serde_json::json!(r);
+    }
+    let dir = root().join("target/bench-static");
+    let _ = std::fs::create_dir_all(&dir);
+    let path = dir.join(format!("dam_{size}.json"));
+    std::fs::write(&path, serde_json::to_string_pretty(&scene).unwrap()).expect("writing the bench scene");
+    (path, scene)
+}
+
+/// The fill of the static stages' Cholesky factors with AMD and with METIS nested dissection,
+/// symbolic analyses only (no numeric factorisation, so a mesh whose factor would not fit can
+/// be measured), per mesh of `JQ_DAM_FILL` (comma list as `JQ_DAM_STATIC`; unset skips it):
+/// stage a's K̂ and stage c's preconditioner P (`statics::contact::static_matrices`), each
+/// with its unknowns, factor entries (MB at 8 B each), flops of one factorisation and the
+/// analysis's seconds, and the process's peak RSS after the mesh.
+fn static_fill() -> Vec<serde_json::Value> {
+    use jointquake::linalg::{analyse, FillOrdering};
+    let sizes = std::env::var("JQ_DAM_FILL").unwrap_or_default();
+    let mut rows = Vec::new();
+    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (path, _) = static_scene(size);
+        let cache = root().join("target/bench-mesh");
+        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
+            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
+            jointquake::problem::Problem::build(s, mesh).map_err(|e| e.to_string())
+        });
+        let (k0, p) = match problem.map_err(|e| e.to_string()).and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
+            Ok(m) => m,
+            Err(e) => {
+                println!("fill, {size}: skipped ({e})");
+                continue;
+            }
+        };
+        for (stage, m) in [("a: K̂", &k0), ("c: P", &p)] {
+            for ordering in [FillOrdering::Amd, FillOrdering::NestedDissection] {
+                match analyse(m, stage, ordering) {
+                    Ok(a) => {
+                        let (_, peak_mb) = cpu_and_peak();
+                        println!("fill, {size}, stage {stage}: {ordering:?}: {} unknowns, {} entries, factor {:.0} MB, {:.3e} flops, analysis {:.1} s (peak RSS so far {peak_mb:.0} MB)", a.n, m.nnz(), a.factor_entries as f64 * 8e-6, a.factor_flops, a.seconds);
+                        rows.push(serde_json::json!({"mesh": size, "stage": stage, "ordering": format!("{ordering:?}"), "n": a.n, "entries": m.nnz(), "factor_mb": a.factor_entries as f64 * 8e-6, "factor_flops": a.factor_flops, "analysis_s": a.seconds}));
+                    }
+                    Err(e) => println!("fill, {size}, stage {stage}: {ordering:?}: {e}"),
+                }
+            }
+        }
+    }
+    rows
 }
 
 /// The step with each reservoir model against the Westergaard step (issue 28; goals:
@@ -398,24 +465,7 @@ fn static_state() -> Vec<serde_json::Value> {
     let sizes = std::env::var("JQ_DAM_STATIC").unwrap_or_default();
     let mut rows = Vec::new();
     for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let set: serde_json::Value = match size {
-            "coarse" => serde_json::json!({"h": 20, "ht": 3.4, "hr": 40, "hrf": 200}),
-            "default" => serde_json::json!({}),
-            "fine" => serde_json::json!({"h": 5, "ht": 1.25, "hr": 12.5, "hrf": 80}),
-            "h2.5" => serde_json::json!({"h": 2.5, "ht": 0.625, "hr": 6.25, "hrf": 40}),
-            other => panic!("JQ_DAM_STATIC: unknown mesh \"{other}\" (coarse, default, fine, h2.5)"),
-        };
-        let text = std::fs::read_to_string(root().join("pipelines/dam.json")).expect("pipelines/dam.json");
-        let mut scene: serde_json::Value = serde_json::from_str(&text).expect("pipelines/dam.json is JSON");
-        scene["geometry"] = serde_json::json!({"geo": root().join("geo/arch_dam.geo"), "set": set});
-        for rec in scene["loads"]["base"].as_array_mut().into_iter().flatten() {
-            let r = root().join("pipelines").join(rec["record"].as_str().unwrap_or_default());
-            rec["record"] = serde_json::json!(r);
-        }
-        let dir = root().join("target/bench-static");
-        let _ = std::fs::create_dir_all(&dir);
-        let path = dir.join(format!("dam_{size}.json"));
-        std::fs::write(&path, serde_json::to_string_pretty(&scene).unwrap()).expect("writing the bench scene");
+        let (path, scene) = static_scene(size);
         let cache = root().join("target/bench-mesh");
         let t_mesh = Instant::now();
         let loaded = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|s| jointquake::pipeline::load_mesh(&s, Some(&cache)).map_err(|e| e.to_string()));
@@ -424,7 +474,7 @@ fn static_state() -> Vec<serde_json::Value> {
             continue;
         }
         let mesh_s = t_mesh.elapsed().as_secs_f64();
-        let opts = jointquake::pipeline::RunOptions { out_dir: Some(dir.join(size)), mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
+        let opts = jointquake::pipeline::RunOptions { out_dir: Some(root().join("target/bench-static").join(size)), mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
         let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
         let (cpu0, _) = cpu_and_peak();
         let t0 = Instant::now();

@@ -1,6 +1,7 @@
 //! Sparse linear algebra of the model: the global stiffness K as a faer sparse matrix, its
-//! restriction to a set of unknowns, a sparse Cholesky factorisation (symbolic once, numeric
-//! once or again on the same pattern, solves repeated), restarted GMRES for unsymmetric
+//! restriction to a set of unknowns, a sparse Cholesky factorisation (symbolic once with AMD or
+//! METIS nested dissection ([`FillOrdering`]), numeric once or again on the same pattern, solves
+//! repeated), restarted GMRES for unsymmetric
 //! systems preconditioned by such a factorisation, and the lowest modes of K φ = ω² M φ.
 //!
 //! Owns: nothing that changes during a run. Inputs: the immutable [`Model`](crate::model::Model)
@@ -20,11 +21,13 @@ pub mod assemble;
 pub mod cholesky;
 pub mod eigen;
 pub mod krylov;
+pub mod ordering;
 
 pub use assemble::{add_entries, dof_map, from_columns, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
-pub use cholesky::{lu_solve_in_place, SparseCholesky};
+pub use cholesky::{analyse, lu_solve_in_place, CholeskyAnalysis, SparseCholesky};
 pub use eigen::{lowest_modes, Modes, ModesOptions};
 pub use krylov::{gmres_into, GmresInfo, GmresOptions};
+pub use ordering::{nested_dissection, FillOrdering};
 
 /// Failures of the sparse linear algebra, each with what to change.
 #[derive(Debug, thiserror::Error)]

@@ -49,7 +49,7 @@ use crate::contact::joint::{ContactJoint, Method};
 use crate::contact::law::{PairHistory, PairState};
 use crate::contact::ContactState;
 use crate::error::{Error, ModelError};
-use crate::linalg::{add_entries, gmres_into, lu_solve_in_place, stiffness, Csc, GmresOptions, SparseCholesky};
+use crate::linalg::{add_entries, gmres_into, lu_solve_in_place, stiffness, Csc, FillOrdering, GmresOptions, SparseCholesky};
 use crate::problem::Problem;
 use nalgebra::{Matrix3, Vector3};
 
@@ -119,7 +119,7 @@ impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations ({} factorisations in {:.1} s, {} GMRES products in {:.1} s{}; {:.1} s in all, setup {:.1} s; factor {:.0} MB), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations ({} factorisations in {:.1} s, {} GMRES products in {:.1} s{}; {:.1} s in all, setup {:.1} s; factor {:.0} MB, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
             self.solver.factorisations,
             self.solver.factor_seconds,
@@ -129,6 +129,10 @@ impl StaticContactInfo {
             self.seconds,
             self.setup_seconds,
             self.solver.factor_entries as f64 * 8e-6,
+            if self.solver.nested_dissection { "nested dissection" } else { "AMD" },
+            self.solver.analysis_seconds,
+            self.solver.factor_flops,
+            products_per_factorisation(self.solver.factor_flops, self.solver.product_flops),
             self.residual,
             if self.converged { "" } else { " (NOT converged)" },
             self.stick,
@@ -239,15 +243,23 @@ pub struct DirectionStats {
     pub factor_entries: usize,
     pub factor_seconds: f64,
     pub krylov_seconds: f64,
+    /// Flops of one numeric factorisation and of one GMRES product (the refactorisation rule's
+    /// estimates, [`products_per_factorisation`]).
+    pub factor_flops: f64,
+    pub product_flops: f64,
+    /// Seconds of the symbolic analysis (ordering included) and whether it was nested
+    /// dissection (else AMD).
+    pub analysis_seconds: f64,
+    pub nested_dissection: bool,
 }
 
 /// The Newton direction d = K_T⁻¹ R with K_T = K̂ + Σ_p B_pᵀ (S_p + C_p) B_p (the pair tangents
 /// of [`PairTangent`], applied pair by pair, never assembled): GMRES
 /// (`linalg::krylov::gmres_into`) preconditioned by the sparse Cholesky factorisation of the
 /// symmetric positive definite P = K̂ + Σ_p B_pᵀ S_p B_p. P's pattern (K̂ and every pair's block,
-/// open or not) is analysed once (AMD ordering); P is factorised again only when the last
-/// direction's GMRES needed more than [`REFACTOR_PRODUCTS`] products (or did not converge), not
-/// on every change of a pair's state: K_T − P is then the friction couplings C_p (one rank-one
+/// open or not) is analysed once ([`STATIC_ORDERING`]); P is factorised again only when the
+/// GMRES products since its last factorisation cost as much as a factorisation
+/// ([`products_per_factorisation`]), not on every change of a pair's state: K_T − P is then the friction couplings C_p (one rank-one
 /// term per slipping pair) and the changed blocks of the pairs that opened, slipped or moved
 /// since the factorisation, a correction of low rank that GMRES absorbs in a few products
 /// (on the fine dam a numeric factorisation costs as much as some hundred products).
@@ -261,21 +273,49 @@ struct TangentSolver {
     /// position in `p.val`.
     pair_pos: Vec<usize>,
     chol: Option<SparseCholesky>,
-    stale_products: bool,
+    /// The fill-reducing ordering of P's analysis.
+    ordering: FillOrdering,
+    /// GMRES products since the last factorisation, and what one factorisation is worth in
+    /// products ([`products_per_factorisation`]).
+    products_since: usize,
+    budget: f64,
     stats: DirectionStats,
     y: Vec<f64>,
 }
 
-/// GMRES products above which the next direction refactorises the preconditioner: 15. Why: a
-/// fresh factorisation needs 1 to 3 products at the forcing term 1e-2, a stale one 20 to 80;
-/// on the default dam mesh one numeric factorisation costs about 15 products, and 15 took less
-/// CPU there than 40 or a refactorisation at every change of a pair's state (11.4 s against
-/// 16.0 s and 12.8 s: docs/performance.md §7b).
-pub const REFACTOR_PRODUCTS: usize = 15;
+/// How many times faster, in flops per second, a numeric factorisation runs than a GMRES
+/// product (dimensionless): 7. Why: the factorisation's supernodes are dense blocks
+/// (matrix–matrix kernels, compute-bound), a product is two triangular solves with the factor
+/// and a sparse product (each entry read once: memory-bound). Measured on one core of this
+/// machine (4 December, nested dissection; docs/performance.md §7b): seconds per factorisation
+/// / seconds per product against [`SparseCholesky::factor_flops`] / [`product_flops`] gave 7.9
+/// on the coarse dam mesh, 7.3 on the default, 7.0 on the fine.
+pub const FACTOR_SPEEDUP: f64 = 7.0;
 
+/// Floating-point operations of one GMRES product with the preconditioner: the sparse product
+/// with P's pattern (2 per entry; the pair terms are of the same order), the two triangular
+/// solves with its factor (4 per factor entry), and the Gram–Schmidt against about 10 Krylov
+/// vectors (4 n each way).
+fn product_flops(p_entries: usize, factor_entries: usize, n: usize) -> f64 {
+    2.0 * p_entries as f64 + 4.0 * factor_entries as f64 + 40.0 * n as f64
+}
+
+/// The refactorisation rule, written once: GMRES products that cost as much as one numeric
+/// factorisation of the preconditioner, factor_flops / [`FACTOR_SPEEDUP`] / product_flops
+/// (at least 1). The preconditioner is factorised again before a direction when the products
+/// made since its last factorisation reach this (ski rental: the products a stale
+/// preconditioner costs beyond a fresh one's 1–3 are never more than one factorisation's
+/// worth, so the total is within 2× of the best choice made knowing the future); a direction
+/// on a stale preconditioner that needs more than this many products is stopped and redone on
+/// a fresh one. Why not a fixed count (15 before): one factorisation costs about 14 products on
+/// the default dam mesh but about 50 on the fine one, so a fixed count refactorised the fine
+/// mesh too often (docs/performance.md §7b).
+fn products_per_factorisation(factor_flops: f64, product_flops: f64) -> f64 {
+    (factor_flops / FACTOR_SPEEDUP / product_flops.max(1.0)).max(1.0)
+}
 
 impl TangentSolver {
-    fn new(k0: &Csc, pairs: &[Pair]) -> TangentSolver {
+    fn new(k0: &Csc, pairs: &[Pair], ordering: FillOrdering) -> TangentSolver {
         let mut entries = Vec::new();
         for p in pairs {
             for wc in &p.w {
@@ -298,7 +338,7 @@ impl TangentSolver {
         }
         let pair_pos = entries.iter().map(|&(a, b, _)| pos(a, b)).collect();
         let n = k0.n_rows;
-        TangentSolver { p, k0_pos, pair_pos, chol: None, stale_products: false, stats: DirectionStats::default(), y: vec![0.0; n] }
+        TangentSolver { p, k0_pos, pair_pos, chol: None, ordering, products_since: 0, budget: 1.0, stats: DirectionStats::default(), y: vec![0.0; n] }
     }
 
     /// P's values for the tangents `tangents`, then its numeric factorisation.
@@ -325,19 +365,26 @@ impl TangentSolver {
         let what = "static stage with the joints active: the Newton preconditioner K + the pairs' stiffness";
         match self.chol.as_mut() {
             Some(ch) => ch.refactor(&self.p, what),
-            None => SparseCholesky::factor(&self.p, what, faer::Par::Seq).map(|ch| self.chol = Some(ch)),
+            None => SparseCholesky::factor_ordered(&self.p, what, faer::Par::Seq, self.ordering).map(|ch| self.chol = Some(ch)),
         }
         .map_err(|e| ModelError::Invalid(e.to_string()))?;
-        self.stale_products = false;
+        self.products_since = 0;
         self.stats.factorisations += 1;
-        self.stats.factor_entries = self.chol.as_ref().map_or(0, |c| c.factor_entries());
+        if let Some(ch) = self.chol.as_ref() {
+            self.stats.factor_entries = ch.factor_entries();
+            self.stats.factor_flops = ch.factor_flops();
+            self.stats.product_flops = product_flops(self.p.nnz(), ch.factor_entries(), ch.n());
+            self.stats.analysis_seconds = ch.analysis_seconds();
+            self.stats.nested_dissection = ch.ordering() == FillOrdering::NestedDissection;
+            self.budget = products_per_factorisation(self.stats.factor_flops, self.stats.product_flops);
+        }
         self.stats.factor_seconds += start.elapsed().as_secs_f64();
         Ok(())
     }
 
     /// r ← K_T⁻¹ r, to the relative residual `eta` (the forcing term).
     fn direction_in_place(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent], r: &mut [f64], eta: f64) -> Result<(), Error> {
-        let changed = self.chol.is_none() || self.stale_products;
+        let changed = self.chol.is_none() || self.products_since as f64 >= self.budget;
         if changed {
             self.factorise(k0, pairs, tangents)?;
         }
@@ -345,7 +392,8 @@ impl TangentSolver {
             // a preconditioner made at older states gets a few times the products that call for
             // a refactorisation, then is refactorised at these states
             let fresh = changed || attempt > 0;
-            let opts = GmresOptions { tolerance: eta, max_iterations: if fresh { GmresOptions::default().max_iterations } else { 3 * REFACTOR_PRODUCTS }, ..Default::default() };
+            let stale_cap = self.budget.ceil() as usize;
+            let opts = GmresOptions { tolerance: eta, max_iterations: if fresh { GmresOptions::default().max_iterations } else { stale_cap }, ..Default::default() };
             let start = std::time::Instant::now();
             let chol = self.chol.as_mut().expect("factorised above");
             self.y.fill(0.0);
@@ -367,8 +415,8 @@ impl TangentSolver {
             let g = gmres_into(apply, |v| chol.solve_in_place(v), r, &mut self.y, &opts);
             self.stats.krylov_products += g.iterations;
             self.stats.krylov_seconds += start.elapsed().as_secs_f64();
+            self.products_since += g.iterations;
             if g.converged {
-                self.stale_products = g.iterations > REFACTOR_PRODUCTS;
                 r.copy_from_slice(&self.y);
                 return Ok(());
             }
@@ -423,6 +471,17 @@ fn mortar_points(problem: &Problem, contact: &ContactState, ji: usize) -> Result
 }
 
 pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64) -> Result<(Vec<f64>, StaticContactInfo), Error> {
+    solve_static_increment_ordered(problem, f, contact, penalty_factor, STATIC_ORDERING)
+}
+
+/// The fill-reducing ordering of the static stages' Cholesky factorisations: `Auto`, nested
+/// dissection from `linalg::ordering::NESTED_DISSECTION_FROM` unknowns, AMD below. Why: on the
+/// fine dam METIS's factor of stage c's preconditioner is smaller and cheaper than AMD's
+/// (docs/performance.md §7b), and on the h 2.5 m mesh AMD's does not fit in memory.
+pub const STATIC_ORDERING: FillOrdering = FillOrdering::Auto;
+
+/// [`solve_static_increment`] with the preconditioner's fill-reducing ordering `ordering`.
+pub fn solve_static_increment_ordered(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64, ordering: FillOrdering) -> Result<(Vec<f64>, StaticContactInfo), Error> {
     let start = std::time::Instant::now();
     let model = &problem.model;
     let k_full = stiffness(model, &vec![true; model.materials.len()]);
@@ -434,7 +493,7 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     let mut pairs = active_pairs(problem, &t, &k_full, contact, penalty_factor, &mut info)?;
     let residual = Residual { k0: &k0, f0: &f0, joints: &problem.joints, nf: norm(&f0) };
     info.setup_seconds = start.elapsed().as_secs_f64();
-    let uh = newton(&residual, &mut pairs, t.n, &mut info)?;
+    let uh = newton(&residual, &mut pairs, t.n, ordering, &mut info)?;
     // the result and the pairs' records
     let mut du = vec![0.0; t.n_dofs];
     t.expand_into(&uh, &mut du);
@@ -442,6 +501,22 @@ pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut Contac
     record_pairs_into(problem, &pairs, &uh, contact, &mut info);
     info.seconds = start.elapsed().as_secs_f64();
     Ok((du, info))
+}
+
+/// The matrices the static stages factorise, for measuring their fill without factorising
+/// them: stage a's K̂ (the stiffness with the tied joints bonded, `bonding::Bonding`) and the
+/// pattern of stage c's preconditioner P (K̂ plus every pair's block, with zeros there), with
+/// the pairs of the initial configuration.
+pub fn static_matrices(problem: &Problem) -> Result<(Csc, Csc), Error> {
+    let model = &problem.model;
+    let k_full = stiffness(model, &vec![true; model.materials.len()]);
+    let tied: Vec<&ContactJoint> = problem.joints.iter().filter(|j| j.law.tied).collect();
+    let t = Bonding::build(model, &tied, |d| model.is_free(d / 3, d % 3) && k_full.col_ptr[d + 1] > k_full.col_ptr[d])?;
+    let k0 = t.reduce(&k_full);
+    let contact = ContactState::new(&problem.joints);
+    let pairs = active_pairs(problem, &t, &k_full, &contact, PENALTY_FACTOR, &mut StaticContactInfo::default())?;
+    let p = TangentSolver::new(&k0, &pairs, STATIC_ORDERING).p;
+    Ok((k0, p))
 }
 
 /// The pairs of the joints that are not tied, with their relative motion over the reduced
@@ -552,14 +627,14 @@ impl Residual<'_> {
 /// Newton's iteration on the `n` reduced unknowns from 0, with a backtracking line search;
 /// counts each pair's state changes, writes the iterations, residual and solver statistics
 /// into `info`. Returns the reduced solution.
-fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, info: &mut StaticContactInfo) -> Result<Vec<f64>, Error> {
+fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, ordering: FillOrdering, info: &mut StaticContactInfo) -> Result<Vec<f64>, Error> {
     let k0 = residual.k0;
     let mut uh = vec![0.0; n];
     let (mut r, mut r_try) = (vec![0.0; n], vec![0.0; n]);
     let (mut closed, mut closed_try) = (Vec::new(), Vec::new());
     let mut tangents = Vec::with_capacity(pairs.len());
     let mut u_try = vec![0.0; n];
-    let mut solver = TangentSolver::new(k0, pairs);
+    let mut solver = TangentSolver::new(k0, pairs, ordering);
     let (mut res_prev, mut eta) = (None, FORCING_MAX);
     for it in 0..=MAX_ITERATIONS {
         crate::interrupt::check("the static state (Newton iterations with contact)")?;
@@ -638,6 +713,17 @@ fn record_pairs_into(problem: &Problem, pairs: &[Pair], uh: &[f64], contact: &mu
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_factorisation_is_worth_its_flops_in_products() {
+        // the rule's arithmetic: factor_flops / FACTOR_SPEEDUP / product_flops, at least 1
+        // (never refactorise before a product was made), and more products for a denser factor
+        let p = product_flops(1_000, 10_000, 100);
+        assert_eq!(p, 2_000.0 + 40_000.0 + 4_000.0);
+        assert_eq!(products_per_factorisation(20.0 * FACTOR_SPEEDUP * p, p), 20.0);
+        assert_eq!(products_per_factorisation(0.0, p), 1.0);
+        assert_eq!(products_per_factorisation(1.0, 0.0), 1.0);
+    }
 
     #[test]
     fn forcing_term_follows_eisenstat_walker_within_its_bounds() {

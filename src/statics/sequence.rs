@@ -38,9 +38,9 @@ use crate::contact::joint::ContactJoint;
 use crate::contact::query::select_projection;
 use crate::contact::ContactState;
 use crate::error::{Error, ModelError};
-use crate::linalg::{stiffness, SparseCholesky};
+use crate::linalg::{stiffness, FillOrdering, SparseCholesky};
 use crate::problem::Problem;
-use crate::statics::contact::solve_static_increment;
+use crate::statics::contact::{solve_static_increment, STATIC_ORDERING};
 use nalgebra::Vector3;
 
 /// One stage of the sequence.
@@ -73,12 +73,12 @@ impl SequenceReport {
 /// The linear static solution u of K u = F with the joints `bonded` tied (the others carry
 /// nothing), and its residual ‖Tᵀ (F − K u)‖ / ‖Tᵀ F‖.
 pub fn linear_static(problem: &Problem, bonded: &[&ContactJoint], f: &[f64]) -> Result<(Vec<f64>, f64, Bonding), Error> {
-    linear_static_timed(problem, bonded, f).map(|(u, r, t, _)| (u, r, t))
+    linear_static_ordered(problem, bonded, f, STATIC_ORDERING).map(|(u, r, t, _)| (u, r, t))
 }
 
-/// [`linear_static`] with its cost: the seconds of the assembly and ties, of the factorisation
-/// (analysis and numeric), and the factor's entries.
-fn linear_static_timed(problem: &Problem, bonded: &[&ContactJoint], f: &[f64]) -> Result<(Vec<f64>, f64, Bonding, (f64, f64, usize)), Error> {
+/// [`linear_static`] with the fill-reducing ordering `ordering`, and its cost: the seconds of
+/// the assembly and ties, of the factorisation (analysis and numeric), and the factor's entries.
+pub fn linear_static_ordered(problem: &Problem, bonded: &[&ContactJoint], f: &[f64], ordering: FillOrdering) -> Result<(Vec<f64>, f64, Bonding, (f64, f64, usize)), Error> {
     let start = std::time::Instant::now();
     let model = &problem.model;
     let k = stiffness(model, &vec![true; model.materials.len()]);
@@ -86,7 +86,7 @@ fn linear_static_timed(problem: &Problem, bonded: &[&ContactJoint], f: &[f64]) -
     let kh = t.reduce(&k);
     let fh = t.reduce_vector(f);
     let assembled = start.elapsed().as_secs_f64();
-    let mut chol = SparseCholesky::factor(&kh, "static stage", faer::Par::Seq).map_err(|e| ModelError::Invalid(e.to_string()))?;
+    let mut chol = SparseCholesky::factor_ordered(&kh, "static stage", faer::Par::Seq, ordering).map_err(|e| ModelError::Invalid(e.to_string()))?;
     let cost = (assembled, start.elapsed().as_secs_f64() - assembled, chol.factor_entries());
     let mut uh = fh.clone();
     chol.solve_in_place(&mut uh);
@@ -105,19 +105,25 @@ fn linear_static_timed(problem: &Problem, bonded: &[&ContactJoint], f: &[f64]) -
 /// Stage (a): self-weight with the joints that are not tied open, the tied ones bonded.
 /// Returns u and the stage's report.
 pub fn self_weight_open_joints(problem: &Problem) -> Result<(Vec<f64>, StageReport), Error> {
+    self_weight_open_joints_ordered(problem, STATIC_ORDERING)
+}
+
+/// [`self_weight_open_joints`] with the fill-reducing ordering `ordering`.
+pub fn self_weight_open_joints_ordered(problem: &Problem, ordering: FillOrdering) -> Result<(Vec<f64>, StageReport), Error> {
     let model = &problem.model;
     let mut gravity_only = problem.loads.clone();
     gravity_only.static_forces.clear();
     let mut f = vec![0.0; 3 * model.n_nodes()];
     gravity_only.external_force_into(model, 0.0, true, false, &mut f);
     let tied: Vec<&ContactJoint> = problem.joints.iter().filter(|j| j.law.tied).collect();
-    let (u, residual, t, (assembly_s, factor_s, entries)) = linear_static_timed(problem, &tied, &f)?;
+    let (u, residual, t, (assembly_s, factor_s, entries)) = linear_static_ordered(problem, &tied, &f, ordering)?;
     let note = format!(
-        "{} tied joint(s) bonded ({} slave nodes), {} joint(s) open; {} unknowns, assembly {assembly_s:.1} s, Cholesky {factor_s:.1} s (factor {:.0} MB)",
+        "{} tied joint(s) bonded ({} slave nodes), {} joint(s) open; {} unknowns, assembly {assembly_s:.1} s, Cholesky {factor_s:.1} s ({}, factor {:.0} MB)",
         tied.len(),
         t.info.tied,
         problem.joints.len() - tied.len(),
         t.n,
+        if ordering.resolve(t.n) == FillOrdering::NestedDissection { "nested dissection" } else { "AMD" },
         entries as f64 * 8e-6
     );
     Ok((u, StageReport { name: "a: self-weight, joints ungrouted".into(), method: "direct solve".into(), residual, steps: 0, note }))

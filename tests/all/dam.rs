@@ -632,6 +632,49 @@ fn dam_reservoir_stage_with_active_joints_converges_and_its_penalty_error_is_sma
     assert!((a / b - 1.0).abs() < 1e-3);
 }
 
+/// The static state on the coarse dam with METIS nested dissection instead of AMD for the
+/// Cholesky factorisations (stage a's K̂, stage c's preconditioner): the ordering changes only
+/// the round-off of the direct solves and, in stage c, which GMRES products the preconditioner
+/// needs. Reference: the AMD solution of the same stages. Tolerances: stage a's u to 1e-10
+/// relative to its largest entry (two direct solves of a system of condition ~1e8); stage c's
+/// Δu to 1e-8 relative (Newton stops at ‖R‖/‖F‖ < 1e-8 on either path: measured 1e-10), with
+/// the same pair counts in each state.
+#[test]
+fn dam_static_state_is_the_same_with_nested_dissection_as_with_amd() {
+    use jointquake::linalg::FillOrdering;
+    let pb = dam_static_problem();
+    let (ua, _) = jointquake::statics::sequence::self_weight_open_joints_ordered(&pb, FillOrdering::Amd).unwrap();
+    let (un, stage) = jointquake::statics::sequence::self_weight_open_joints_ordered(&pb, FillOrdering::NestedDissection).unwrap();
+    assert!(stage.note.contains("nested dissection"), "{}", stage.note);
+    let rel = |a: &[f64], b: &[f64]| {
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
+    };
+    let da = rel(&ua, &un);
+    println!("stage a: largest difference {da:.2e} of the largest displacement");
+    assert!(da < 1e-10, "{da}");
+    let mut f = vec![0.0; ua.len()];
+    for &(n, fv) in &pb.loads.static_forces {
+        for c in 0..3 {
+            f[3 * n + c] += fv[c];
+        }
+    }
+    let solve = |ordering| {
+        let mut contact = jointquake::contact::ContactState::new(&pb.joints);
+        jointquake::statics::sequence::grout(&pb, &mut contact, &ua).unwrap();
+        jointquake::statics::contact::solve_static_increment_ordered(&pb, &f, &mut contact, jointquake::statics::contact::PENALTY_FACTOR, ordering).unwrap()
+    };
+    let (dua, ia) = solve(FillOrdering::Amd);
+    let (dun, inn) = solve(FillOrdering::NestedDissection);
+    println!("AMD: {}\nND:  {}", ia.line(), inn.line());
+    assert!(ia.converged && inn.converged);
+    assert!(inn.solver.nested_dissection && !ia.solver.nested_dissection);
+    assert_eq!((ia.stick, ia.slip, ia.open), (inn.stick, inn.slip, inn.open));
+    let dc = rel(&dua, &dun);
+    println!("stage c: largest difference {dc:.2e} of the largest displacement");
+    assert!(dc < 1e-8, "{dc}");
+}
+
 /// Regression: the contact impulse on a node with an inertia block (the reservoir's added mass)
 /// used the inverse mass along the pair's normal in every direction, so on the wet nodes of
 /// the contraction joints it acted as if the water were not there in the joint's shear
