@@ -28,7 +28,9 @@
 //! "massive,massless,radiating"),
 //! `JQ_BENCH_REPEATS` (default 3), `JQ_BENCH_STEPS` (default 100), `JQ_BENCH_GS_TOL` (Gauss–Seidel
 //! tolerance as a fraction of joint J01's size; default the solver's, 1e-12 of the model size),
-//! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint), `JQ_BENCH_THREADS`
+//! `JQ_DAM_PER_JOINT` (set: print lost nodes, searches and sweeps per joint), `JQ_DAM_METHOD`
+//! (the contraction joints' method: "nts", the default, or "mortar", issue 31; the base stays
+//! tied node to segment), `JQ_BENCH_THREADS`
 //! (comma list of thread counts, default "1": the first builds the model and times the steps as
 //! above; each further count times as many steps more, in its own rayon pool, with its speed-up
 //! over the first, the bound Amdahl's law puts on it with the contact's set-up and record serial
@@ -80,6 +82,9 @@ fn scene(massless: bool, radiating: bool) -> Scene {
         "loads": {"gravity": {}, "traction": [{"group": "face:upstream", "traction": [0.0, 1e6, 0.0]}]},
         "time": {"duration": 1.0, "energy_tolerance": 1.0}
     });
+    // the contraction joints' method (issue 31: the dam step with mortar joints)
+    let method = std::env::var("JQ_DAM_METHOD").unwrap_or_else(|_| "nts".into());
+    v["joints"][0]["method"] = serde_json::json!(method);
     if radiating {
         let rec = |c: &str| root().join(format!("pipelines/records/dam_dl5073_arch_I_s1_{c}.txt")).to_string_lossy().to_string();
         v["loads"]["base"] = serde_json::json!([

@@ -6,6 +6,13 @@
 //! point, u_s = Σ_I N_I u_I, with N_I the shape functions of the master face hit by the line
 //! from X_s along the slave normal on the **initial** configuration (the tagger's surfaces and
 //! candidate faces; `contact::query::select_projection`). The same weights act on x, y and z.
+//! A joint with `method: "mortar"` is tied by its dual mortar condition instead, D u_s = M u_m
+//! over the overlaps of its faces on the initial configuration: D is diagonal (dual shape
+//! functions), so each slave node's row is u_s = Σ_k c_k u_k with c_k = M_sk / D_ss, the
+//! node's mortar master point (`ContactSolver::mortar_master_points`, docs/contact.md "Dual
+//! mortar"; the weights sum to one). It passes the patch test on non-matching meshes (a
+//! uniform stress is transmitted exactly), which the node-to-segment tie does not. A slave node
+//! below the mortar cover (near the master's free edge) is tied by the projection rule below.
 //! The eliminated unknowns give the transformation u = T û; a matrix A of the model becomes
 //! Â = Tᵀ A T and a load F becomes Tᵀ F (exact: no penalty, the frequencies and the static
 //! state are those of the constrained model).
@@ -22,8 +29,10 @@
 //! - a fixed master component contributes nothing (it is 0); a fixed slave component stays
 //!   fixed.
 
-use crate::contact::joint::ContactJoint;
+use crate::contact::force::ContactSolver;
+use crate::contact::joint::{ContactJoint, Method};
 use crate::contact::query::select_projection;
+use crate::contact::ContactState;
 use crate::error::ModelError;
 use crate::linalg::{Csc, NONE};
 use crate::model::Model;
@@ -42,6 +51,10 @@ pub struct TieInfo {
     pub nearest_node: usize,
     /// Slave nodes already tied by an earlier joint (their second constraint is dropped).
     pub already_tied: usize,
+    /// Slave nodes of mortar joints tied by their mortar master point (not counted in
+    /// `projected`, `widened`, `nearest_node`, which count the node-to-segment ties, a mortar
+    /// node below the cover among them).
+    pub mortar: usize,
 }
 
 /// The transformation u = T û of a model with bonded joints, on its free dofs.
@@ -101,6 +114,18 @@ pub fn master_point(model: &Model, j: &ContactJoint, i: usize) -> Result<(Vec<(u
     })
 }
 
+/// Per slave node of the mortar joint `j`, its mortar master point on the initial
+/// configuration: model nodes and weights c_k = M_jk / D_jj (module header); `None` below the
+/// mortar cover. The contact solver is scratch for this joint's integrals (one per joint: the
+/// joints bonded here are not one slice of the problem's).
+fn mortar_ties(model: &Model, j: &ContactJoint) -> Result<Vec<Option<Vec<(usize, f64)>>>, ModelError> {
+    let one = std::slice::from_ref(j);
+    let state = ContactState::new(one);
+    let zero = vec![0.0; 3 * model.n_nodes()];
+    let points = ContactSolver::new(model, one).mortar_master_points(model, 0, &state.joints[0], &zero).map_err(|e| ModelError::Invalid(format!("bonding joint \"{}\": {e}", j.tag.name)))?;
+    Ok(points.into_iter().map(|p| p.map(|(masters, _)| masters)).collect())
+}
+
 /// Per slave node its masters (model nodes) and weights, for the joints `bonded`.
 fn tie_nodes(model: &Model, joints: &[&ContactJoint]) -> Result<(Vec<Option<Vec<(usize, f64)>>>, TieInfo), ModelError> {
     let mut ties: Vec<Option<Vec<(usize, f64)>>> = vec![None; model.n_nodes()];
@@ -108,9 +133,16 @@ fn tie_nodes(model: &Model, joints: &[&ContactJoint]) -> Result<(Vec<Option<Vec<
     let mut order: Vec<&&ContactJoint> = joints.iter().filter(|j| j.law.tied).collect();
     order.extend(joints.iter().filter(|j| !j.law.tied));
     for j in order {
+        let mut mortar = if j.method == Method::Mortar { mortar_ties(model, j)? } else { Vec::new() };
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
             if ties[s].is_some() {
                 info.already_tied += 1;
+                continue;
+            }
+            if let Some(masters) = mortar.get_mut(i).and_then(Option::take) {
+                ties[s] = Some(masters);
+                info.mortar += 1;
+                info.tied += 1;
                 continue;
             }
             let (masters, hit) = master_point(model, j, i)?;

@@ -46,6 +46,7 @@
 
 use crate::statics::bonding::{master_point, Bonding, MasterHit};
 use crate::contact::joint::{ContactJoint, Method};
+use crate::contact::force::ContactSolver;
 use crate::contact::law::{PairHistory, PairState};
 use crate::contact::ContactState;
 use crate::error::{Error, ModelError};
@@ -450,26 +451,28 @@ impl TangentSolver {
     }
 }
 
-/// Solve the increment `f` (forces over every model dof) on `problem`'s model with the tied
-/// joints bonded and the other joints active, from grouted joints (gap 0, no force), with the
-/// penalty `penalty_factor` × the slave node's diagonal stiffness ([`PENALTY_FACTOR`]). Returns
-/// Δu over every model dof and the report, and writes each pair's state, forces and gap into
-/// `contact`.
 /// Dual mortar joint `ji`: each slave node's mortar master point (model nodes, weights
 /// c_k = M_jk / D_jj) and its area D_jj on the initial configuration
 /// (`ContactSolver::mortar_master_points`; `None` below the mortar cover); empty for the other
-/// methods.
+/// methods. `solver` is the static solve's one contact solver (scratch only: each call
+/// evaluates the joint's integrals afresh), built on its first mortar joint.
 #[allow(clippy::type_complexity)]
-fn mortar_points(problem: &Problem, contact: &ContactState, ji: usize) -> Result<Vec<Option<(Vec<(usize, f64)>, f64)>>, Error> {
+fn mortar_points<'p>(problem: &'p Problem, solver: &mut Option<ContactSolver<'p>>, contact: &ContactState, ji: usize) -> Result<Vec<Option<(Vec<(usize, f64)>, f64)>>, Error> {
     let (model, j) = (&problem.model, &problem.joints[ji]);
     if j.method != Method::Mortar {
         return Ok(Vec::new());
     }
     let zero = vec![0.0; 3 * model.n_nodes()];
-    let points = crate::contact::force::ContactSolver::new(model, &problem.joints).mortar_master_points(model, ji, &contact.joints[ji], &zero);
+    let solver = solver.get_or_insert_with(|| ContactSolver::new(model, &problem.joints));
+    let points = solver.mortar_master_points(model, ji, &contact.joints[ji], &zero);
     Ok(points.map_err(|e| ModelError::Invalid(format!("static contact, joint \"{}\": {e}", j.tag.name)))?)
 }
 
+/// Solve the increment `f` (forces over every model dof) on `problem`'s model with the tied
+/// joints bonded and the other joints active, from grouted joints (gap 0, no force), with the
+/// penalty `penalty_factor` × the slave node's diagonal stiffness ([`PENALTY_FACTOR`]). Returns
+/// Δu over every model dof and the report, and writes each pair's state, forces and gap into
+/// `contact`.
 pub fn solve_static_increment(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64) -> Result<(Vec<f64>, StaticContactInfo), Error> {
     solve_static_increment_ordered(problem, f, contact, penalty_factor, STATIC_ORDERING)
 }
@@ -527,11 +530,12 @@ fn active_pairs(problem: &Problem, t: &Bonding, k_full: &Csc, contact: &ContactS
     let model = &problem.model;
     let mut pairs = Vec::new();
     let unformed = crate::contact::joint::unformed_pairs(&problem.joints);
+    let mut solver = None;
     for (ji, j) in problem.joints.iter().enumerate() {
         if j.law.tied {
             continue;
         }
-        let mut mortar = mortar_points(problem, contact, ji)?;
+        let mut mortar = mortar_points(problem, &mut solver, contact, ji)?;
         for (i, &s) in j.tag.slave_nodes().iter().enumerate() {
             if unformed[ji][i] {
                 // the slave of a tied joint is the slave of no other joint (the rule: `unformed_pairs`)
