@@ -292,8 +292,11 @@ impl Grid {
             hi = hi.sup(b);
             size += (b - a).max();
         }
-        let cell = (2.0 * size / boxes.len().max(1) as f64).max(1e-9);
-        let dims = [0, 1, 2].map(|k| (((hi[k] - lo[k]) / cell).floor() as usize + 1).min(1 << 10));
+        // twice the mean element extent, but at most about MAX_BINS bins over the elements' box
+        const MAX_BINS: f64 = 4e6;
+        let ext = hi - lo;
+        let cell = (2.0 * size / boxes.len().max(1) as f64).max(((ext.x + 1e-9) * (ext.y + 1e-9) * (ext.z + 1e-9) / MAX_BINS).cbrt()).max(1e-9);
+        let dims = [0, 1, 2].map(|k| ((ext[k] / cell).floor() as usize + 1).min(1 << 10));
         let mut g = Grid { lo, cell, dims, bins: vec![Vec::new(); dims[0] * dims[1] * dims[2]] };
         for (i, (a, b)) in boxes.iter().enumerate() {
             for bin in g.bins_of(a, b) {
