@@ -16,6 +16,7 @@
 
 use crate::error::{ModelError, OutputError};
 use crate::model::Model;
+use super::linearise::{LinearisedEnvelope, Lineariser};
 use crate::scene::EnvelopeSpec;
 use crate::vtk::vtu::{Field, Grid, write_vtu};
 use serde::{Deserialize, Serialize};
@@ -222,6 +223,10 @@ pub struct StressEnvelope {
     /// Time of the last sample [s].
     pub t_last: f64,
     pub faces: Vec<FaceEnvelope>,
+    /// The stresses linearised through the thickness (`output.envelope.linearise`;
+    /// [`super::linearise`]). Absent in files written before it or without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linearised: Option<LinearisedEnvelope>,
 }
 
 impl StressEnvelope {
@@ -273,6 +278,7 @@ pub struct EnvelopeWriter {
     samples: usize,
     t_last: f64,
     stress: Vec<[f64; 6]>,
+    lineariser: Option<Lineariser>,
 }
 
 impl EnvelopeWriter {
@@ -314,7 +320,20 @@ impl EnvelopeWriter {
             }
             faces.push(v);
         }
+        let lineariser = match &spec.linearise {
+            Some(l) => {
+                let of = |g: &str| {
+                    spec.faces.iter().position(|f| f == g).ok_or_else(|| {
+                        ModelError::Invalid(format!("output.envelope.linearise: \"{g}\" is not one of output.envelope.faces {:?}", spec.faces))
+                    })
+                };
+                let (i, j) = (of(&l.from)?, of(&l.to)?);
+                Some(Lineariser::create(model, (&l.from, &faces[i]), (&l.to, &faces[j]))?)
+            }
+            None => None,
+        };
         Ok(EnvelopeWriter {
+            lineariser,
             stride: spec.stride.max(1),
             groups: spec.faces.clone(),
             faces,
@@ -339,6 +358,9 @@ impl EnvelopeWriter {
                     self.min_s3[e] = (p[2], t);
                 }
             }
+        }
+        if let Some(l) = self.lineariser.as_mut() {
+            l.sample(&self.stress);
         }
         self.samples += 1;
         self.t_last = t;
@@ -425,6 +447,7 @@ impl EnvelopeWriter {
             samples: self.samples,
             t_last: self.t_last,
             faces,
+            linearised: self.lineariser.as_ref().map(Lineariser::envelope),
         }
     }
 
@@ -485,7 +508,7 @@ mod tests {
         // and 3 m² at 2, 4 and 11 MPa: above 3 MPa 5 m², above 5 MPa 3 m², above 10 MPa 3 m².
         for tets in [false, true] {
             let m = crate::linalg::assemble::tests::box_model(tets, [2, 3, 2]);
-            let w = EnvelopeWriter::create(&m, &EnvelopeSpec { faces: vec!["b:x0".into()], stride: 1 }).unwrap();
+            let w = EnvelopeWriter::create(&m, &EnvelopeSpec { faces: vec!["b:x0".into()], stride: 1, linearise: None }).unwrap();
             let env = w.envelope(&m);
             let total: f64 = env.faces[0].areas.iter().sum();
             assert!((total - 1.0).abs() < 1e-12, "tets {tets}: {total}");

@@ -12,6 +12,7 @@ pub mod history;
 pub mod joint_envelope;
 pub mod pvsm;
 pub mod joints;
+pub mod linearise;
 pub mod recorder;
 pub mod summary;
 

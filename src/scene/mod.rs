@@ -656,6 +656,20 @@ pub struct EnvelopeSpec {
     /// Steps between two samples (and the last step). Default 10.
     #[serde(default = "ten")]
     pub stride: usize,
+    /// Also linearise the stresses through the thickness between two of `faces`
+    /// (`output::linearise`): a cut from each face of `from` to the nearest point of `to`.
+    /// Default none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub linearise: Option<LineariseSpec>,
+}
+
+/// `output.envelope.linearise`: the face groups a through-thickness cut joins (both in
+/// `output.envelope.faces`), e.g. a dam's upstream (`from`) and downstream (`to`) faces.
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineariseSpec {
+    pub from: String,
+    pub to: String,
 }
 
 fn ten() -> usize {

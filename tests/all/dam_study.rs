@@ -339,6 +339,17 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
     assert!(obj["max_tension"].as_f64().unwrap() <= nts["stress"]["upstream_tension"]["value"].as_f64().unwrap(), "outside the band ≤ the raw peak: {obj}");
     assert_eq!(nts["stress"]["areas_above"].as_array().unwrap().len(), 3);
     assert!(md.contains("## Face stresses outside the band at the rock"), "{md}");
+    // the stresses linearised through the thickness (issue 30 §4): a cut per upstream face
+    // (made or dropped), in report.json and in their table; the linearised surface tension
+    // bounds its membrane part
+    let lin = env.linearised.as_ref().expect("the base scene linearises");
+    assert_eq!(lin.cuts.len() + lin.dropped, ups.elements.len());
+    assert!(lin.cuts.len() > ups.elements.len() / 2, "{} cuts of {}", lin.cuts.len(), ups.elements.len());
+    let l = &nts["stress"]["linearised"];
+    assert_eq!(l["cuts"].as_u64().unwrap(), lin.cuts.len() as u64, "{l}");
+    let arch = &l["arch"];
+    assert!(arch["tension_start"].as_f64().unwrap().max(arch["tension_end"].as_f64().unwrap()) >= arch["membrane_tension"].as_f64().unwrap(), "{arch}");
+    assert!(md.contains("## Stresses linearised through the thickness"), "{md}");
     // the verdicts against the extrapolated reference (issue 30 §5). Without the study file's
     // `report.reference` (dam_reference.json, absent here) the report says so and falls back.
     assert!(md.contains("**No extrapolated reference**"), "{md}");

@@ -31,7 +31,8 @@ pub mod static_table;
 
 use crate::error::{Error, OutputError, StudyError};
 use crate::mesh::pattern::{GroupPattern, natural_cmp};
-use crate::output::envelope::{Extreme, OBJECTIVE_BAND, ObjectiveStress, StressEnvelope, TENSION_THRESHOLDS};
+use crate::output::envelope::{Extreme, FaceEnvelope, OBJECTIVE_BAND, ObjectiveStress, StressEnvelope, TENSION_THRESHOLDS};
+use crate::output::linearise::{LinearisedEnvelope, LinearisedExtremes};
 use crate::output::history::HistoryTable;
 use crate::scene::{ContactMethod, Scene};
 use crate::study::{KindReport, RunResult, Study, StudyKind, StudyResults, kind_params};
@@ -254,9 +255,61 @@ pub struct FaceStress {
     /// Per threshold of [`TENSION_THRESHOLDS`]: (threshold [Pa], upstream area, downstream
     /// area [m²]) of the faces whose σ1 exceeded it.
     pub areas_above: Vec<(f64, f64, f64)>,
+    /// The stresses linearised through the thickness (`None`: an envelope without them).
+    pub linearised: Option<LinearisedStress>,
+}
+
+/// The arch and cantilever stresses linearised through the thickness from the upstream to the
+/// downstream face ([`crate::output::linearise`]): extremes over all cuts, and over the cuts
+/// whose upstream face is outside [`OBJECTIVE_BAND`] of the rock ("start" = upstream, "end" =
+/// downstream).
+#[derive(Clone, Debug, Serialize)]
+pub struct LinearisedStress {
+    pub arch: LinearisedExtremes,
+    pub cantilever: LinearisedExtremes,
+    pub arch_outside_band: Option<LinearisedExtremes>,
+    pub cantilever_outside_band: Option<LinearisedExtremes>,
+    /// Cuts made, and upstream faces without a cut (less than `MIN_COVERAGE` in the dam).
+    pub cuts: usize,
+    pub dropped: usize,
+}
+
+impl LinearisedStress {
+    /// From the envelope's linearised part; `upstream` is the cuts' `from` face group.
+    fn of(l: &LinearisedEnvelope, upstream: &FaceEnvelope) -> Option<LinearisedStress> {
+        let band = (upstream.corners.len() == upstream.elements.len() && !upstream.corners.is_empty()).then(|| upstream.in_band(OBJECTIVE_BAND));
+        let outside = |arch: bool| band.as_ref().and_then(|b| l.extremes(arch, |f| !b[f]));
+        Some(LinearisedStress {
+            arch: l.extremes(true, |_| true)?,
+            cantilever: l.extremes(false, |_| true)?,
+            arch_outside_band: outside(true),
+            cantilever_outside_band: outside(false),
+            cuts: l.cuts.len(),
+            dropped: l.dropped,
+        })
+    }
 }
 
 impl FaceStress {
+    /// From a run's `envelope.json` (`dir` is the run directory).
+    fn read(p: &DamParams, dir: &std::path::Path) -> Result<FaceStress, Error> {
+        let env = StressEnvelope::read(dir)?;
+        let face = |g: &str| {
+            env.face(g).ok_or_else(|| OutputError::read(dir.join("envelope.json"), format!("no envelope of face group \"{g}\" (the scene's `output.envelope.faces` must name it)")))
+        };
+        let (u, d) = (face(&p.faces.upstream)?, face(&p.faces.downstream)?);
+        Ok(FaceStress {
+            upstream_tension: u.max_tension.clone(),
+            upstream_compression: u.max_compression.clone(),
+            downstream_tension: d.max_tension.clone(),
+            downstream_compression: d.max_compression.clone(),
+            upstream_objective: u.objective(OBJECTIVE_BAND),
+            downstream_objective: d.objective(OBJECTIVE_BAND),
+            areas_above: TENSION_THRESHOLDS.iter().map(|&t| (t, u.area_above(t), d.area_above(t))).collect(),
+            linearised: env.linearised.as_ref().filter(|l| l.from == p.faces.upstream).and_then(|l| LinearisedStress::of(l, u)),
+        })
+    }
+
     /// Largest tension over both faces [Pa].
     pub fn tension(&self) -> f64 {
         self.upstream_tension
@@ -551,24 +604,7 @@ impl DamKind {
                 })
                 .collect()
         });
-        let stress = if r.failed().is_none() {
-            let env = StressEnvelope::read(&r.dir)?;
-            let face = |g: &str| {
-                env.face(g).ok_or_else(|| OutputError::read(r.dir.join("envelope.json"), format!("no envelope of face group \"{g}\" (the scene's `output.envelope.faces` must name it)")))
-            };
-            let (u, d) = (face(&p.faces.upstream)?, face(&p.faces.downstream)?);
-            Some(FaceStress {
-                upstream_tension: u.max_tension.clone(),
-                upstream_compression: u.max_compression.clone(),
-                downstream_tension: d.max_tension.clone(),
-                downstream_compression: d.max_compression.clone(),
-                upstream_objective: u.objective(OBJECTIVE_BAND),
-                downstream_objective: d.objective(OBJECTIVE_BAND),
-                areas_above: TENSION_THRESHOLDS.iter().map(|&t| (t, u.area_above(t), d.area_above(t))).collect(),
-            })
-        } else {
-            None
-        };
+        let stress = if r.failed().is_none() { Some(FaceStress::read(p, &r.dir)?) } else { None };
         let mut crest = Vec::new();
         for m in [
             &p.monitors.crown,

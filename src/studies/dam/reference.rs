@@ -35,10 +35,23 @@ pub enum Quantity {
     ObjectiveCompression,
     /// Largest |u_r| of the crest monitors [m].
     Crest,
+    /// Largest arch tension linearised through the thickness, over all cuts and both faces
+    /// ([`crate::output::linearise`]) [Pa].
+    ArchTension,
+    /// Most compressive linearised arch stress [Pa].
+    ArchCompression,
+    /// Largest linearised cantilever tension [Pa].
+    CantileverTension,
+    /// Most compressive linearised cantilever stress [Pa].
+    CantileverCompression,
+    /// Area of both faces whose σ1 exceeded 3, 5, 10 MPa ([`crate::output::envelope::TENSION_THRESHOLDS`]) [m²].
+    AreaAbove3,
+    AreaAbove5,
+    AreaAbove10,
 }
 
 impl Quantity {
-    pub const ALL: [Quantity; 8] = [
+    pub const ALL: [Quantity; 15] = [
         Quantity::Opening,
         Quantity::Slip,
         Quantity::SlipPath,
@@ -47,6 +60,13 @@ impl Quantity {
         Quantity::ObjectiveTension,
         Quantity::ObjectiveCompression,
         Quantity::Crest,
+        Quantity::ArchTension,
+        Quantity::ArchCompression,
+        Quantity::CantileverTension,
+        Quantity::CantileverCompression,
+        Quantity::AreaAbove3,
+        Quantity::AreaAbove5,
+        Quantity::AreaAbove10,
     ];
 
     /// The quantity of a run (`None`: the run has no stress envelope, or no face corners).
@@ -61,7 +81,20 @@ impl Quantity {
             Quantity::ObjectiveTension => s.and_then(|s| s.objective_tension()),
             Quantity::ObjectiveCompression => s.and_then(|s| s.objective_compression()),
             Quantity::Crest => (!r.crest.is_empty()).then(|| r.max_crest()),
+            Quantity::ArchTension => s.and_then(|s| s.linearised.as_ref()).map(|l| l.arch.tension()),
+            Quantity::ArchCompression => s.and_then(|s| s.linearised.as_ref()).map(|l| l.arch.compression()),
+            Quantity::CantileverTension => s.and_then(|s| s.linearised.as_ref()).map(|l| l.cantilever.tension()),
+            Quantity::CantileverCompression => s.and_then(|s| s.linearised.as_ref()).map(|l| l.cantilever.compression()),
+            Quantity::AreaAbove3 => Self::area(s, 0),
+            Quantity::AreaAbove5 => Self::area(s, 1),
+            Quantity::AreaAbove10 => Self::area(s, 2),
         }
+    }
+
+    /// Both faces' area above threshold `k` [m²]; `None` without face areas (no corners).
+    fn area(s: Option<&super::FaceStress>, k: usize) -> Option<f64> {
+        let s = s.filter(|s| s.upstream_objective.is_some())?;
+        s.areas_above.get(k).map(|&(_, u, d)| u + d)
     }
 
     /// As the tables name it, and its SI unit.
@@ -75,6 +108,13 @@ impl Quantity {
             Quantity::ObjectiveTension => ("largest tension outside the band", "Pa"),
             Quantity::ObjectiveCompression => ("largest compression outside the band", "Pa"),
             Quantity::Crest => ("largest crest displacement |u_r|", "m"),
+            Quantity::ArchTension => ("largest arch tension, linearised", "Pa"),
+            Quantity::ArchCompression => ("largest arch compression, linearised", "Pa"),
+            Quantity::CantileverTension => ("largest cantilever tension, linearised", "Pa"),
+            Quantity::CantileverCompression => ("largest cantilever compression, linearised", "Pa"),
+            Quantity::AreaAbove3 => ("face area above 3 MPa", "m2"),
+            Quantity::AreaAbove5 => ("face area above 5 MPa", "m2"),
+            Quantity::AreaAbove10 => ("face area above 10 MPa", "m2"),
         }
     }
 }
@@ -268,5 +308,48 @@ mod tests {
         let bad = [run("h7", Method::Nts, 3.0, 0.3)];
         let e = DamReference::from_runs(&p, "s.json", &bad, vec![]).unwrap_err();
         assert!(e.contains("\"h7\""), "{e}");
+    }
+
+    #[test]
+    fn a_reference_file_written_before_the_linearised_stresses_and_areas_reads_and_the_new_quantities_round_trip() {
+        // Backward compatibility (issue 30 §4): a file of the 4 December format (eight
+        // quantities, no linearised stress, no areas) reads; its new quantities are absent.
+        let old = r#"{"study": "s.json", "commits": ["aad97b6"], "meshes": [{"label": "coarse", "h": 20.0}],
+            "note": "one mesh: no error band", "values": [{"quantity": "objective_tension", "unit": "Pa",
+            "method": "NTS", "level": 3.0, "values": [{"mesh": "coarse", "h": 20.0, "value": 5.66e7}],
+            "extrapolation": {"behaviour": "one_mesh", "order": null, "extrapolated": 5.66e7, "band": null, "finest": 5.66e7}}]}"#;
+        let dir = std::env::temp_dir().join(format!("jq_reference_old_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("old.json");
+        std::fs::write(&f, old).unwrap();
+        let r = DamReference::read(&f).unwrap();
+        assert_eq!(r.get(Quantity::ObjectiveTension, Method::Nts, 3.0).unwrap().extrapolation.finest, 5.66e7);
+        assert!(r.get(Quantity::ArchTension, Method::Nts, 3.0).is_none() && r.get(Quantity::AreaAbove3, Method::Nts, 3.0).is_none());
+        // a run with linearised stresses and areas: 2 + 1 m² above 3 MPa (the sum of both
+        // faces), the linearised arch tension the larger surface value 4 MPa
+        use crate::output::linearise::LinearisedExtremes;
+        let x = |t: f64| LinearisedExtremes { tension_start: t, tension_end: 0.5 * t, compression_start: -t, compression_end: -2.0 * t, membrane_tension: 0.0, membrane_compression: 0.0, tension_at: [0.0; 3] };
+        let o = crate::output::envelope::ObjectiveStress { band: 20.0, max_tension: 1.0, max_tension_at: [0.0; 3], max_compression: -1.0, max_compression_at: [0.0; 3], kept: 1, excluded: 0 };
+        let mut a = run("coarse", Method::Nts, 3.0, 0.3);
+        a.stress = Some(super::super::FaceStress {
+            upstream_tension: Default::default(),
+            upstream_compression: Default::default(),
+            downstream_tension: Default::default(),
+            downstream_compression: Default::default(),
+            upstream_objective: Some(o.clone()),
+            downstream_objective: Some(o),
+            areas_above: vec![(3e6, 2.0, 1.0), (5e6, 1.0, 0.0), (10e6, 0.0, 0.0)],
+            linearised: Some(super::super::LinearisedStress { arch: x(4e6), cantilever: x(1e6), arch_outside_band: None, cantilever_outside_band: None, cuts: 1, dropped: 0 }),
+        });
+        let p: DamParams = serde_json::from_value(serde_json::json!({"main_mesh": "coarse", "seed": {"source": "", "levels": [], "opening_nts_mm": [], "opening_ntn_mm": [], "slip_nts_over_ntn": 0.0, "tension_nts_mpa": 0.0, "tension_ntn_mpa": 0.0, "compression_nts_mpa": 0.0, "compression_ntn_mpa": 0.0}, "mesh_sizes": {"coarse": 20}})).unwrap();
+        let r = DamReference::from_runs(&p, "s.json", &[a], vec![]).unwrap();
+        let v = |q| r.get(q, Method::Nts, 3.0).unwrap().extrapolation.finest;
+        assert_eq!((v(Quantity::AreaAbove3), v(Quantity::AreaAbove5), v(Quantity::AreaAbove10)), (3.0, 1.0, 0.0));
+        assert_eq!((v(Quantity::ArchTension), v(Quantity::ArchCompression), v(Quantity::CantileverTension)), (4e6, -8e6, 1e6));
+        // the areas' names follow the thresholds they read
+        assert_eq!(crate::output::envelope::TENSION_THRESHOLDS, [3e6, 5e6, 10e6]);
+        r.write(&f).unwrap();
+        assert_eq!(DamReference::read(&f).unwrap(), r);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -190,6 +190,7 @@ pub fn report(kind: &DamKind, results: &StudyResults) -> Result<KindReport, Erro
     largest_slip_section(&r, &mut doc);
     stress_section(&r, &mut doc);
     objective_stress_section(&r, &mut doc);
+    linearised_stress_section(&r, &mut doc);
     stress_against_seed_section(&r, &mut doc);
     super::face_maps::face_maps_section(&r, &mut doc)?;
     super::joint_maps::joint_maps_section(&r, &mut doc)?;
@@ -657,6 +658,37 @@ fn objective_stress_section(r: &DamReport, doc: &mut Doc) {
     md.push_str(&t.to_markdown());
 }
 
+/// The arch and cantilever stresses linearised through the thickness, per run: the largest
+/// tension and compression at the upstream and downstream surface, over all cuts and outside the
+/// band at the rock.
+fn linearised_stress_section(r: &DamReport, doc: &mut Doc) {
+    use crate::output::envelope::OBJECTIVE_BAND;
+    use crate::output::linearise::LinearisedExtremes;
+    let runs: Vec<&DamRun> = r.runs.iter().filter(|x| x.stress.as_ref().is_some_and(|s| s.linearised.is_some())).collect();
+    if runs.is_empty() {
+        return;
+    }
+    let md = &mut doc.md;
+    let _ = writeln!(md, "\n## Stresses linearised through the thickness (arch and cantilever)\n");
+    let _ = writeln!(
+        md,
+        "As USACE EM 1110-2-6053 evaluates a 3-D model (and ASME VIII-2 5.A a stress classification line): a straight cut from each upstream face's centre to the nearest point of the downstream face; along it the arch stress (horizontal, tangential to the faces) and the cantilever stress (in the faces' vertical plane) are linearised, membrane σ_m = mean through the thickness t, bending σ_b = 6/t² ∫σ (x − t/2) dx, surface values σ_m ∓ σ_b upstream / downstream, each enveloped over the record at the envelope's samples (`output::linearise`). It integrates the element stresses (each element's centre value over its stretch of the cut), so a single element's peak at a re-entrant corner weighs by its share of the thickness only; with n elements through the thickness a linear bending stress is read as (1 − 1/n²) of itself. Upstream / downstream, MPa, tension positive; \"outside band\": the cuts whose upstream face is more than {} m from the rock.\n",
+        fmt_sig(OBJECTIVE_BAND, 3)
+    );
+    let mut t = Table::new(["level", "run", "cuts (dropped)", "arch tension up / down", "arch compression up / down", "cantilever tension up / down", "cantilever compression up / down", "outside band: arch tension / compression, cantilever tension / compression"]);
+    let tc = |e: &LinearisedExtremes| [format!("{} / {}", mpa(e.tension_start), mpa(e.tension_end)), format!("{} / {}", mpa(e.compression_start), mpa(e.compression_end))];
+    for x in runs {
+        let l = x.stress.as_ref().and_then(|s| s.linearised.as_ref()).expect("filtered");
+        let band = match (&l.arch_outside_band, &l.cantilever_outside_band) {
+            (Some(a), Some(c)) => format!("{} / {}, {} / {}", mpa(a.tension()), mpa(a.compression()), mpa(c.tension()), mpa(c.compression())),
+            _ => "–".into(),
+        };
+        let (a, c) = (tc(&l.arch), tc(&l.cantilever));
+        let _ = t.push_row([lvl(x.level), format!("{} {}", x.method.name(), x.mesh), format!("{} ({})", l.cuts, l.dropped), a[0].clone(), a[1].clone(), c[0].clone(), c[1].clone(), band]);
+    }
+    md.push_str(&t.to_markdown());
+}
+
 /// What the verdicts and the speed-against-accuracy chart are judged against.
 fn reference_section(r: &DamReport, doc: &mut Doc) {
     let md = &mut doc.md;
@@ -679,7 +711,11 @@ fn reference_section(r: &DamReport, doc: &mut Doc) {
     );
     let mut t = Table::new(["level", "method", "quantity", "per mesh (coarsest first)", "behaviour, order", "value ± band"]);
     for v in &rf.values {
-        let f = |x: f64| if v.unit == "Pa" { format!("{} MPa", mpa(x)) } else { format!("{} mm", mm(x)) };
+        let f = |x: f64| match v.unit.as_str() {
+            "Pa" => format!("{} MPa", mpa(x)),
+            "m2" => format!("{} m²", fmt_sig(x, 3)),
+            _ => format!("{} mm", mm(x)),
+        };
         let e = &v.extrapolation;
         let _ = t.push_row([
             lvl(v.level),
