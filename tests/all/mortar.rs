@@ -274,9 +274,13 @@ fn crest_numbers(pb: &jointquake::problem::Problem, u: &[f64]) -> (f64, f64) {
 /// scratch carries nothing from one joint to the next); (2) stage c's static table with joint
 /// J01 in mortar is the one measured before the change (code of main at bb78b6e): 14 Newton
 /// iterations, pairs stick 1004 / slip 103 / open 15, crest's largest displacement
-/// 5.016140172894090e-2 m, crown uy 5.016000594835923e-2 m; tolerance 1e-12 relative (the same
-/// arithmetic in the same order: only where the scratch lives changed). The table with all 28
-/// contraction joints in mortar is printed (docs/contact.md).
+/// 5.016140172894090e-2 m, crown uy 5.016000594835923e-2 m; tolerance 1e-9 relative and the
+/// same pair states (measured at bb78b6e with the same arithmetic to 1e-12; since then stage c
+/// refactorises its preconditioner by a cost rule, branch `static`, which changes the Newton
+/// path, 11 iterations instead of 14, and the table by 6.5e-13: the static tables of that
+/// change agree within 4e-10, so 1e-9 keeps the check on the mortar points' reuse without
+/// pinning the linear solver's path). The table with all 28 contraction joints in mortar is
+/// printed (docs/contact.md).
 #[test]
 fn mortar_static_stage_reuses_one_contact_solver() {
     use jointquake::contact::force::ContactSolver;
@@ -301,10 +305,10 @@ fn mortar_static_stage_reuses_one_contact_solver() {
     let (u, info) = dam_static_stages(&pb);
     let (largest, crown) = crest_numbers(&pb, &u);
     println!("MEASURED J01 mortar: {} ; crest largest {largest:.15e} crown uy {crown:.15e}", info.line());
-    assert!(info.converged && info.iterations == 14, "{}", info.line());
+    assert!(info.converged, "{}", info.line());
     assert_eq!((info.stick, info.slip, info.open), (1004, 103, 15), "{}", info.line());
-    assert!((largest / 5.016140172894090e-2 - 1.0).abs() < 1e-12, "crest {largest:.15e}");
-    assert!((crown / 5.016000594835923e-2 - 1.0).abs() < 1e-12, "crown {crown:.15e}");
+    assert!((largest / 5.016140172894090e-2 - 1.0).abs() < 1e-9, "crest {largest:.15e}");
+    assert!((crown / 5.016000594835923e-2 - 1.0).abs() < 1e-9, "crown {crown:.15e}");
 }
 
 /// Tied mortar in the construction sequence (issue 31): the coarse dam with its contraction
