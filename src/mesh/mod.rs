@@ -11,6 +11,7 @@
 //! `$PhysicalNames` is called `"<dim>:<tag>"`.
 
 pub mod cell;
+pub mod geometry;
 pub mod msh;
 pub mod pattern;
 pub mod quality;

@@ -28,6 +28,7 @@
 //! within each element: tested below), 0.75 with 2 elements, 0.94 with 4, 0.99 with 10.
 
 use crate::error::ModelError;
+use crate::mesh::geometry::closest_on_triangle;
 use crate::model::Model;
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -240,38 +241,11 @@ fn element_interval(model: &Model, e: usize, p: P3, d: P3, t: f64) -> Option<(f6
         .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
 }
 
-/// Closest point of triangle `abc` to `p` (Ericson, Real-Time Collision Detection, 5.1.5).
-fn closest_on_triangle(p: P3, a: P3, b: P3, c: P3) -> Vector3<f64> {
-    let (p, a, b, c) = (Vector3::from(p), Vector3::from(a), Vector3::from(b), Vector3::from(c));
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let den = 1.0 / (va + vb + vc);
-    a + ab * (vb * den) + ac * (vc * den)
+/// Closest point of triangle `abc` to `p` ([`closest_on_triangle`]'s barycentric weights).
+fn closest_point_on_triangle(p: P3, a: P3, b: P3, c: P3) -> Vector3<f64> {
+    let (a, b, c) = (Vector3::from(a), Vector3::from(b), Vector3::from(c));
+    let l = closest_on_triangle(a, b, c, &Vector3::from(p));
+    a * l[0] + b * l[1] + c * l[2]
 }
 
 /// A uniform grid of the elements' bounding boxes, for the elements a segment may cross.
@@ -388,7 +362,7 @@ impl Lineariser {
         for (face, &(c, _)) in from.1.iter().enumerate() {
             let x: Vec<P3> = mesh.cells[c].nodes().iter().map(|&i| mesh.nodes[i as usize]).collect();
             let p: P3 = [0, 1, 2].map(|k| x.iter().map(|q| q[k]).sum::<f64>() / x.len() as f64);
-            let q = tris.iter().map(|t| closest_on_triangle(p, t[0], t[1], t[2])).min_by(|a, b| (a - Vector3::from(p)).norm_squared().total_cmp(&(b - Vector3::from(p)).norm_squared())).expect("non-empty");
+            let q = tris.iter().map(|t| closest_point_on_triangle(p, t[0], t[1], t[2])).min_by(|a, b| (a - Vector3::from(p)).norm_squared().total_cmp(&(b - Vector3::from(p)).norm_squared())).expect("non-empty");
             match Self::cut(model, &grid, face, p, q.into()) {
                 Some(cut) => cuts.push(cut),
                 None => dropped += 1,
