@@ -275,8 +275,9 @@ fn main() {
     let reservoir = pool.install(|| reservoir_models(repeats, steps));
     let static_rows = static_state();
     let fill_rows = static_fill();
+    let factor_rows = static_factor();
     let _ = std::fs::create_dir_all(root().join("target/bench"));
-    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir, "static_state": static_rows, "static_fill": fill_rows})).unwrap());
+    let _ = std::fs::write(root().join("target/bench/dam.json"), serde_json::to_string_pretty(&serde_json::json!({"load_before": load, "runs": rows, "reservoir": reservoir, "static_state": static_rows, "static_fill": fill_rows, "static_factor": factor_rows})).unwrap());
 }
 
 /// The bench scene of the static state on mesh `size` (coarse, default, fine, h2.5): written
@@ -338,6 +339,79 @@ fn static_fill() -> Vec<serde_json::Value> {
                     Err(e) => println!("fill, {size}, stage {stage}: {ordering:?}: {e}"),
                 }
             }
+        }
+    }
+    rows
+}
+
+/// The numeric factorisation and the solves of stage c's preconditioner P on one thread and on
+/// all of rayon's (issue 30 §1), per mesh of `JQ_DAM_FACTOR` (comma list as `JQ_DAM_STATIC`;
+/// unset skips it): P's pattern with K̂'s values (`statics::contact::static_matrices`: the pair
+/// blocks are zeros, so P = K̂, positive definite, with the fill and flops of the Newton
+/// preconditioner), nested dissection. Per `Par` (one thread, then all of rayon's global pool:
+/// `RAYON_NUM_THREADS`): the numeric factorisation (best of `JQ_FACTOR_REPEATS`, default 2,
+/// wall and process CPU), its flop rate, and one solve (best of 10); the solution's largest
+/// difference from the one-thread factor's, relative to its largest entry.
+fn static_factor() -> Vec<serde_json::Value> {
+    use jointquake::linalg::{FillOrdering, SparseCholesky};
+    let sizes = std::env::var("JQ_DAM_FACTOR").unwrap_or_default();
+    let repeats: usize = std::env::var("JQ_FACTOR_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(2usize).max(1);
+    let mut rows = Vec::new();
+    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
+        let (path, _) = static_scene(size);
+        let cache = root().join("target/bench-mesh");
+        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
+            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
+            jointquake::problem::Problem::build(s, mesh).map_err(|e| e.to_string())
+        });
+        let p = match problem.and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
+            Ok((_, p)) => p,
+            Err(e) => {
+                println!("factor, {size}: skipped ({e})");
+                continue;
+            }
+        };
+        let b: Vec<f64> = (0..p.n_rows).map(|i| (i as f64 * 0.37).sin()).collect();
+        let mut reference: Option<Vec<f64>> = None;
+        for par in [faer::Par::Seq, faer::Par::rayon(0)] {
+            let threads = par.degree();
+            let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
+            let mut ch = match SparseCholesky::factor_ordered(&p, "P", par, FillOrdering::NestedDissection) {
+                Ok(ch) => ch,
+                Err(e) => {
+                    println!("factor, {size}: {e}");
+                    break;
+                }
+            };
+            let (mut wall, mut cpu) = (f64::INFINITY, f64::INFINITY);
+            for _ in 0..repeats {
+                let (c0, t0) = (cpu_and_peak().0, Instant::now());
+                ch.refactor(&p, "P").expect("P refactorised");
+                wall = wall.min(t0.elapsed().as_secs_f64());
+                cpu = cpu.min(cpu_and_peak().0 - c0);
+            }
+            let mut x = b.clone();
+            let (mut sw, mut sc) = (f64::INFINITY, f64::INFINITY);
+            for _ in 0..10 {
+                x.copy_from_slice(&b);
+                let (c0, t0) = (cpu_and_peak().0, Instant::now());
+                ch.solve_in_place(&mut x);
+                sw = sw.min(t0.elapsed().as_secs_f64());
+                sc = sc.min(cpu_and_peak().0 - c0);
+            }
+            let diff = reference.as_ref().map_or(0.0, |r| {
+                let scale = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                r.iter().zip(&x).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / scale
+            });
+            if reference.is_none() {
+                reference = Some(x.clone());
+            }
+            let flops = ch.factor_flops();
+            println!(
+                "factor, {size}, {threads} thread(s) (load {load}): {} unknowns, factor {:.0} MB, {flops:.3e} flops; numeric factorisation {wall:.2} s wall, {cpu:.2} s CPU ({:.2e} flops/s wall, {:.2e} per CPU s); solve (one thread, `linalg::cholesky::SOLVE_PAR`) {:.3} s wall / {:.3} s CPU; solution vs 1 thread {diff:.1e}",
+                p.n_rows, ch.factor_entries() as f64 * 8e-6, flops / wall, flops / cpu, sw, sc
+            );
+            rows.push(serde_json::json!({"mesh": size, "threads": threads, "load_before": load, "n": p.n_rows, "factor_mb": ch.factor_entries() as f64 * 8e-6, "factor_flops": flops, "factor_wall_s": wall, "factor_cpu_s": cpu, "solve_wall_s": sw, "solve_cpu_s": sc, "solution_vs_one_thread": diff}));
         }
     }
     rows

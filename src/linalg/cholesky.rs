@@ -11,6 +11,13 @@ use faer::linalg::cholesky::llt::factor::LltError as NumericLltError;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering};
 use faer::{Conj, MatMut, Par, Side};
 
+/// The threads of the triangular solves: one (`Par::Seq`). Why: a solve with one right-hand
+/// side reads each entry of the factor once (memory-bound) and faer parallelises it only
+/// within each supernode's dense blocks; measured on the fine dam's preconditioner (754 MB
+/// factor, load 6, docs/performance.md §7b) a solve took 0.125 s of CPU on two threads against
+/// 0.116 s on one, and no less wall time.
+pub const SOLVE_PAR: Par = Par::Seq;
+
 /// A factorised symmetric positive definite matrix.
 pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
@@ -18,6 +25,7 @@ pub struct SparseCholesky {
     /// Scratch of one solve with `scratch_cols` right-hand sides.
     scratch: MemBuffer,
     scratch_cols: usize,
+    /// Threads of the numeric factorisation.
     par: Par,
     /// Entries of the matrix the symbolic analysis was made for (a refactorisation must have
     /// the same pattern).
@@ -36,8 +44,9 @@ impl std::fmt::Debug for SparseCholesky {
 
 impl SparseCholesky {
     /// Factorise `a` (its lower triangle is read). `what` names the matrix in errors.
-    /// `par`: faer's parallelism for the factorisation and the solves (`Par::Seq` for small
-    /// systems or when the caller already runs in parallel).
+    /// `par`: faer's parallelism for the numeric factorisations (`Par::Seq` for small systems or
+    /// when the caller already runs in parallel; a run's: [`super::run_par`]). The solves run on
+    /// one thread whatever `par` ([`SOLVE_PAR`]).
     /// The ordering is faer's AMD ([`SparseCholesky::factor_ordered`] chooses another).
     pub fn factor(a: &Csc, what: &str, par: Par) -> Result<SparseCholesky, LinalgError> {
         SparseCholesky::factor_ordered(a, what, par, FillOrdering::Amd)
@@ -57,7 +66,7 @@ impl SparseCholesky {
         let mut values = Vec::new();
         values.try_reserve_exact(symbolic.len_val()).map_err(|_| oom())?;
         values.resize(symbolic.len_val(), 0.0);
-        let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, par)).map_err(|_| oom())?;
+        let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, SOLVE_PAR)).map_err(|_| oom())?;
         let mut chol = SparseCholesky { symbolic, values, scratch, scratch_cols: 1, par, pattern_nnz: a.nnz(), ordering, analysis_seconds };
         chol.refactor(a, what)?;
         Ok(chol)
@@ -117,10 +126,10 @@ impl SparseCholesky {
     /// X ← A⁻¹ X for a column-major block of right-hand sides.
     pub fn solve_mat_in_place(&mut self, rhs: MatMut<'_, f64>) {
         if rhs.ncols() > self.scratch_cols {
-            self.scratch = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), self.par));
+            self.scratch = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), SOLVE_PAR));
             self.scratch_cols = rhs.ncols();
         }
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, self.par, MemStack::new(&mut self.scratch));
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, SOLVE_PAR, MemStack::new(&mut self.scratch));
     }
 
     /// X ← A⁻¹ X with a scratch of its own (one thread): for blocks of right-hand sides solved

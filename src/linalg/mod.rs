@@ -7,6 +7,7 @@
 //! Owns: nothing that changes during a run. Inputs: the immutable [`Model`](crate::model::Model)
 //! (its element kernels: Hooke's law and the B matrices are not written again here).
 //! Outputs: [`Csc`] matrices, [`SparseCholesky`], [`Modes`], [`gmres_into`]'s solutions.
+//! The threads of a factorisation: [`run_par`], written once.
 //!
 //! Conventions (written once, here):
 //! - Degrees of freedom are the model's, `3 * node + component`. A *dof map* sends a model dof
@@ -28,6 +29,36 @@ pub use cholesky::{analyse, lu_solve_in_place, CholeskyAnalysis, SparseCholesky}
 pub use eigen::{lowest_modes, Modes, ModesOptions};
 pub use krylov::{gmres_into, GmresInfo, GmresOptions};
 pub use ordering::{nested_dissection, FillOrdering};
+
+/// The threads of a run's sparse Cholesky factorisations (faer's `Par`), one rule for every
+/// caller: those of the rayon pool the caller runs in, which is the run's thread count
+/// (`pipeline::default_threads`: one below 30 000 elements, else all cores; or `--threads`);
+/// `Par::Seq` on one. A factorisation on n threads equals the one-thread factor to round-off
+/// (faer's dense kernels block the supernodes differently), not bit for bit
+/// (docs/performance.md §7b).
+pub fn run_par() -> faer::Par {
+    match rayon::current_num_threads() {
+        0 | 1 => faer::Par::Seq,
+        n => faer::Par::rayon(n),
+    }
+}
+
+/// CPU seconds (user + system) of this process so far, all its threads (getrusage); 0 if the
+/// call fails. For the solvers' cost notes: on a loaded machine the wall time is inflated,
+/// the CPU time much less.
+pub fn cpu_seconds() -> f64 {
+    // SAFETY: a zeroed rusage is a valid value, and getrusage writes only the struct it is given
+    let (r, status) = unsafe {
+        let mut r: libc::rusage = std::mem::zeroed();
+        let status = libc::getrusage(libc::RUSAGE_SELF, &mut r);
+        (r, status)
+    };
+    if status != 0 {
+        return 0.0;
+    }
+    let s = |t: libc::timeval| t.tv_sec as f64 + 1e-6 * t.tv_usec as f64;
+    s(r.ru_utime) + s(r.ru_stime)
+}
 
 /// Failures of the sparse linear algebra, each with what to change.
 #[derive(Debug, thiserror::Error)]

@@ -50,7 +50,7 @@ use crate::contact::force::ContactSolver;
 use crate::contact::law::{PairHistory, PairState};
 use crate::contact::ContactState;
 use crate::error::{Error, ModelError};
-use crate::linalg::{add_entries, gmres_into, lu_solve_in_place, stiffness, Csc, FillOrdering, GmresOptions, SparseCholesky};
+use crate::linalg::{add_entries, cpu_seconds, gmres_into, lu_solve_in_place, run_par, stiffness, Csc, FillOrdering, GmresOptions, SparseCholesky};
 use crate::problem::Problem;
 use nalgebra::{Matrix3, Vector3};
 
@@ -120,12 +120,17 @@ impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations ({} factorisations in {:.1} s, {} GMRES products in {:.1} s{}; {:.1} s in all, setup {:.1} s; factor {:.0} MB, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations ({} factorisations in {:.1} s ({:.1} s CPU on {} thread(s)), {} GMRES products in {:.1} s ({:.1} s CPU; preconditioner {:.1} s, operator {:.1} s){}; {:.1} s in all, setup {:.1} s; factor {:.0} MB, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products; directions {}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
             self.solver.factorisations,
             self.solver.factor_seconds,
+            self.solver.factor_cpu_seconds,
+            self.solver.threads,
             self.solver.krylov_products,
             self.solver.krylov_seconds,
+            self.solver.krylov_cpu_seconds,
+            self.solver.precondition_seconds,
+            self.solver.operator_seconds,
             if self.solver.lu_fallbacks > 0 { format!(", {} LU solves", self.solver.lu_fallbacks) } else { String::new() },
             self.seconds,
             self.setup_seconds,
@@ -134,6 +139,7 @@ impl StaticContactInfo {
             self.solver.analysis_seconds,
             self.solver.factor_flops,
             products_per_factorisation(self.solver.factor_flops, self.solver.product_flops),
+            self.solver.trace.trim(),
             self.residual,
             if self.converged { "" } else { " (NOT converged)" },
             self.stick,
@@ -235,7 +241,7 @@ fn forcing_term(res: f64, res_prev: Option<f64>, eta_prev: f64) -> f64 {
 
 /// How the Newton directions were solved: factorisations of the preconditioner, GMRES
 /// products, direct LU solves (the fallback), and the seconds each took.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct DirectionStats {
     pub factorisations: usize,
     pub krylov_products: usize,
@@ -252,6 +258,18 @@ pub struct DirectionStats {
     /// dissection (else AMD).
     pub analysis_seconds: f64,
     pub nested_dissection: bool,
+    /// CPU seconds (all threads) of the factorisations and of the GMRES solves, and the wall
+    /// seconds of the GMRES solves spent in the preconditioner's triangular solves and in the
+    /// operator's products (the rest: Gram–Schmidt and GMRES's bookkeeping).
+    pub factor_cpu_seconds: f64,
+    pub krylov_cpu_seconds: f64,
+    pub precondition_seconds: f64,
+    pub operator_seconds: f64,
+    /// Threads of the numeric factorisations (`linalg::run_par`).
+    pub threads: usize,
+    /// Per Newton direction its GMRES products, with an `F` before it for each factorisation
+    /// made for it (e.g. "F2 5 14 F3"), so the refactorisation rule's choices can be read.
+    pub trace: String,
 }
 
 /// The Newton direction d = K_T⁻¹ R with K_T = K̂ + Σ_p B_pᵀ (S_p + C_p) B_p (the pair tangents
@@ -344,7 +362,7 @@ impl TangentSolver {
 
     /// P's values for the tangents `tangents`, then its numeric factorisation.
     fn factorise(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent]) -> Result<(), Error> {
-        let start = std::time::Instant::now();
+        let (start, cpu0) = (std::time::Instant::now(), cpu_seconds());
         self.p.val.fill(0.0);
         for (q, &v) in self.k0_pos.iter().zip(&k0.val) {
             self.p.val[*q] += v;
@@ -366,7 +384,7 @@ impl TangentSolver {
         let what = "static stage with the joints active: the Newton preconditioner K + the pairs' stiffness";
         match self.chol.as_mut() {
             Some(ch) => ch.refactor(&self.p, what),
-            None => SparseCholesky::factor_ordered(&self.p, what, faer::Par::Seq, self.ordering).map(|ch| self.chol = Some(ch)),
+            None => SparseCholesky::factor_ordered(&self.p, what, run_par(), self.ordering).map(|ch| self.chol = Some(ch)),
         }
         .map_err(|e| ModelError::Invalid(e.to_string()))?;
         self.products_since = 0;
@@ -380,6 +398,9 @@ impl TangentSolver {
             self.budget = products_per_factorisation(self.stats.factor_flops, self.stats.product_flops);
         }
         self.stats.factor_seconds += start.elapsed().as_secs_f64();
+        self.stats.factor_cpu_seconds += cpu_seconds() - cpu0;
+        self.stats.threads = run_par().degree();
+        self.stats.trace.push('F');
         Ok(())
     }
 
@@ -395,10 +416,12 @@ impl TangentSolver {
             let fresh = changed || attempt > 0;
             let stale_cap = self.budget.ceil() as usize;
             let opts = GmresOptions { tolerance: eta, max_iterations: if fresh { GmresOptions::default().max_iterations } else { stale_cap }, ..Default::default() };
-            let start = std::time::Instant::now();
+            let (start, cpu0) = (std::time::Instant::now(), cpu_seconds());
             let chol = self.chol.as_mut().expect("factorised above");
             self.y.fill(0.0);
+            let (mut precondition_s, mut operator_s) = (0.0, 0.0);
             let apply = |x: &[f64], out: &mut [f64]| {
+                let t = std::time::Instant::now();
                 k0.mul_into(x, out);
                 for (p, tg) in pairs.iter().zip(tangents) {
                     if tg.state == PairState::Open {
@@ -412,10 +435,20 @@ impl TangentSolver {
                         }
                     }
                 }
+                operator_s += t.elapsed().as_secs_f64();
             };
-            let g = gmres_into(apply, |v| chol.solve_in_place(v), r, &mut self.y, &opts);
+            let precondition = |v: &mut [f64]| {
+                let t = std::time::Instant::now();
+                chol.solve_in_place(v);
+                precondition_s += t.elapsed().as_secs_f64();
+            };
+            let g = gmres_into(apply, precondition, r, &mut self.y, &opts);
             self.stats.krylov_products += g.iterations;
             self.stats.krylov_seconds += start.elapsed().as_secs_f64();
+            self.stats.krylov_cpu_seconds += cpu_seconds() - cpu0;
+            self.stats.precondition_seconds += precondition_s;
+            self.stats.operator_seconds += operator_s;
+            self.stats.trace.push_str(&format!("{} ", g.iterations));
             self.products_since += g.iterations;
             if g.converged {
                 r.copy_from_slice(&self.y);

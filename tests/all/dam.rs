@@ -675,6 +675,39 @@ fn dam_static_state_is_the_same_with_nested_dissection_as_with_amd() {
     assert!(dc < 1e-8, "{dc}");
 }
 
+/// The static state's factorisations on the run's threads (issue 30 §1, `linalg::run_par`):
+/// the coarse dam's construction sequence in a rayon pool of one thread and of two. Reference:
+/// the one-thread static table (crest radial displacements, crown stresses). Tolerance: 1e-10
+/// relative to the largest entry of each kind (displacements, stresses): the two-thread
+/// factor differs from the one-thread factor only by round-off (faer's dense kernels block
+/// differently), the Newton path (states, refactorisations) is the same, so the tables agree
+/// far below the Newton tolerance (measured: identical on this mesh, 9e-16 relative on the
+/// default mesh's preconditioner, 6e-15 on the fine's: docs/performance.md §7b).
+#[test]
+fn dam_static_state_on_two_threads_equals_one_thread() {
+    let pb = dam_static_problem();
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut sim = jointquake::simulation::Simulation::new(&pb).unwrap();
+            let report = sim.equilibrate().unwrap();
+            let table = jointquake::studies::dam::static_table::static_table(&pb.model, &sim.state.u).unwrap();
+            (table, report.lines().join("\n"))
+        })
+    };
+    let ((t1, notes1), (t2, notes2)) = (run(1), run(2));
+    println!("one thread:\n{notes1}\ntwo threads:\n{notes2}");
+    assert!(notes1.contains("CPU on 1 thread(s)") && notes2.contains("CPU on 2 thread(s)"), "{notes2}");
+    let radial = |t: &jointquake::studies::dam::static_table::DamStaticTable| t.crest.iter().map(|c| c.radial).collect::<Vec<_>>();
+    let stresses = |t: &jointquake::studies::dam::static_table::DamStaticTable| t.faces.iter().flat_map(|f| [f.arch_min.0, f.arch_max.0, f.cantilever_min.0, f.cantilever_max.0]).collect::<Vec<_>>();
+    for (a, b, what) in [(radial(&t1), radial(&t2), "crest radial displacement"), (stresses(&t1), stresses(&t2), "crown stress")] {
+        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let d = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale;
+        println!("{what}: largest difference {d:.2e} of the largest");
+        assert!(scale > 0.0 && d < 1e-10, "{what}: {d:.2e}");
+    }
+}
+
 /// Regression: the contact impulse on a node with an inertia block (the reservoir's added mass)
 /// used the inverse mass along the pair's normal in every direction, so on the wet nodes of
 /// the contraction joints it acted as if the water were not there in the joint's shear
