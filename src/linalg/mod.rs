@@ -23,6 +23,7 @@ pub mod cholesky;
 pub mod eigen;
 pub mod krylov;
 pub mod ordering;
+pub mod tree_solve;
 
 pub use assemble::{add_entries, dof_map, from_columns, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
 pub use cholesky::{analyse, lu_solve_in_place, CholeskyAnalysis, SparseCholesky};
@@ -33,9 +34,11 @@ pub use ordering::{nested_dissection, FillOrdering};
 /// The threads of a run's sparse Cholesky factorisations (faer's `Par`), one rule for every
 /// caller: those of the rayon pool the caller runs in, which is the run's thread count
 /// (`pipeline::default_threads`: one below 30 000 elements, else all cores; or `--threads`);
-/// `Par::Seq` on one. A factorisation on n threads equals the one-thread factor to round-off
-/// (faer's dense kernels block the supernodes differently), not bit for bit
-/// (docs/performance.md §7b).
+/// `Par::Seq` on one. Measured, the two-thread factor of the coarse, default and fine dam's
+/// preconditioner is bit-identical to the one-thread factor (faer's parallel dense kernels
+/// split the output blocks between the threads, not the sums); faer does not promise it, so
+/// the test `dam_static_state_on_two_threads_equals_one_thread` holds the static state to
+/// round-off (docs/performance.md §7b).
 pub fn run_par() -> faer::Par {
     match rayon::current_num_threads() {
         0 | 1 => faer::Par::Seq,

@@ -120,7 +120,7 @@ impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations ({} factorisations in {:.1} s ({:.1} s CPU on {} thread(s)), {} GMRES products in {:.1} s ({:.1} s CPU; preconditioner {:.1} s, operator {:.1} s){}; {:.1} s in all, setup {:.1} s; factor {:.0} MB, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products; directions {}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations ({} factorisations in {:.1} s ({:.1} s CPU on {} thread(s)), {} GMRES products in {:.1} s ({:.1} s CPU; preconditioner {:.1} s, operator {:.1} s){}; {:.1} s in all, setup {:.1} s; factor {:.0} MB, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products{}; directions {}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
             self.solver.factorisations,
             self.solver.factor_seconds,
@@ -139,6 +139,10 @@ impl StaticContactInfo {
             self.solver.analysis_seconds,
             self.solver.factor_flops,
             products_per_factorisation(self.solver.factor_flops, self.solver.product_flops),
+            match self.solver.split {
+                Some([a, b, top]) => format!("; solves split {:.0} % / {:.0} % / top {:.0} %", 100.0 * a as f64 / (a + b + top).max(1) as f64, 100.0 * b as f64 / (a + b + top).max(1) as f64, 100.0 * top as f64 / (a + b + top).max(1) as f64),
+                None => String::new(),
+            },
             self.solver.trace.trim(),
             self.residual,
             if self.converged { "" } else { " (NOT converged)" },
@@ -267,8 +271,13 @@ pub struct DirectionStats {
     pub operator_seconds: f64,
     /// Threads of the numeric factorisations (`linalg::run_par`).
     pub threads: usize,
-    /// Per Newton direction its GMRES products, with an `F` before it for each factorisation
-    /// made for it (e.g. "F2 5 14 F3"), so the refactorisation rule's choices can be read.
+    /// The preconditioner's solves split over its elimination tree
+    /// (`SparseCholesky::split_solves`): factor entries of the two halves solved at once and
+    /// of the part above them.
+    pub split: Option<[usize; 3]>,
+    /// Per Newton direction (separated by spaces) its GMRES products, an `F` before the count
+    /// of an attempt on a fresh factorisation, a `>` after an attempt on a stale one that did
+    /// not converge within its cap (e.g. "F2 5 35>F3 14"), so the rule's choices can be read.
     pub trace: String,
 }
 
@@ -384,7 +393,11 @@ impl TangentSolver {
         let what = "static stage with the joints active: the Newton preconditioner K + the pairs' stiffness";
         match self.chol.as_mut() {
             Some(ch) => ch.refactor(&self.p, what),
-            None => SparseCholesky::factor_ordered(&self.p, what, run_par(), self.ordering).map(|ch| self.chol = Some(ch)),
+            None => SparseCholesky::factor_ordered(&self.p, what, run_par(), self.ordering).map(|mut ch| {
+                // the GMRES products' solves in two halves of the elimination tree at once
+                self.stats.split = ch.split_solves();
+                self.chol = Some(ch);
+            }),
         }
         .map_err(|e| ModelError::Invalid(e.to_string()))?;
         self.products_since = 0;
@@ -448,7 +461,7 @@ impl TangentSolver {
             self.stats.krylov_cpu_seconds += cpu_seconds() - cpu0;
             self.stats.precondition_seconds += precondition_s;
             self.stats.operator_seconds += operator_s;
-            self.stats.trace.push_str(&format!("{} ", g.iterations));
+            self.stats.trace.push_str(&format!("{}{}", g.iterations, if g.converged { " " } else { ">" }));
             self.products_since += g.iterations;
             if g.converged {
                 r.copy_from_slice(&self.y);
