@@ -95,6 +95,31 @@ fn internal_forces_into(model: &Model, constraints: &mut [&mut dyn Constraint<Co
     }
 }
 
+/// f = K_p u of the elements of one Rayleigh pair (`rock`: the rock's own; else the scene's,
+/// with the part of a constraint standing for the massless elements, as in
+/// [`internal_forces_into`]).
+fn pair_forces_into(model: &Model, constraints: &mut [&mut dyn Constraint<ContactState>], rock: bool, u: &[f64], f: &mut [f64]) {
+    let replaced = constraints.iter().any(|c| c.replaces_massless_elements());
+    model.internal_forces_of_pair_into(rock, replaced, u, f);
+    if replaced && !rock {
+        for c in constraints.iter_mut().filter(|c| c.replaces_massless_elements()) {
+            c.add_internal_force_into(u, f);
+        }
+    }
+}
+
+/// The βK terms of one Rayleigh pair's elements when the pairs' β differ
+/// ([`Model::beta_grouped`]): f = K_p (u[n] + β_p v_b), and K_p u[n], K_p u[n−1] recovered from
+/// it as the one-β step does for K (see `ExplicitSolver::internal_forces_of_step`).
+struct PairForces {
+    /// The rock's own pair (else the scene's).
+    rock: bool,
+    beta: f64,
+    f: Vec<f64>,
+    ku: Vec<f64>,
+    ku_prev: Vec<f64>,
+}
+
 /// Running energy account of the dynamic stage [J].
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Energy {
@@ -204,6 +229,9 @@ pub struct ExplicitSolver {
     pub energy_stride: usize,
     /// Relative energy-growth limit (from the scene). Default 0.05.
     pub energy_tolerance: f64,
+    /// The βK of each Rayleigh pair (the scene's, the rock's own) when their β differ
+    /// ([`Model::beta_grouped`]); empty otherwise (one β: `w`, `ku`, `ku_prev` alone).
+    pairs: Vec<PairForces>,
     /// Components held during the dynamic stage when they differ from [`Model::held`] (a
     /// radiating foundation's far boundary: held through gravity, free with its dashpots
     /// after; `problem::foundation::radiating`). `None`: the model's, in every stage.
@@ -213,7 +241,12 @@ pub struct ExplicitSolver {
 impl ExplicitSolver {
     pub fn new(model: &Model, dt: f64, energy_tolerance: f64) -> ExplicitSolver {
         let n = 3 * model.n_nodes();
-        let nb = if model.beta > 0.0 { n } else { 0 };
+        let nb = if model.stiffness_damped() { n } else { 0 };
+        let pair = |rock: bool, beta: f64| PairForces { rock, beta, f: vec![0.0; n], ku: vec![0.0; n], ku_prev: vec![0.0; n] };
+        let pairs = match &model.rock_damping {
+            Some(r) if model.beta_grouped() => vec![pair(false, model.beta), pair(true, r.beta)],
+            _ => Vec::new(),
+        };
         ExplicitSolver {
             dt,
             f_int: vec![0.0; n],
@@ -225,11 +258,13 @@ impl ExplicitSolver {
             u_nm1: vec![0.0; n],
             energy_stride: 10,
             energy_tolerance,
+            pairs,
             dynamic_held: None,
         }
     }
 
-    /// Internal force of the last step (K u[n], or K(u[n] + β v_b) when β > 0).
+    /// Internal force of the last step (K u[n], or K(u[n] + β v_b) when β > 0, per element its
+    /// pair's β).
     pub fn internal_force(&self) -> &[f64] {
         &self.f_int
     }
@@ -239,15 +274,20 @@ impl ExplicitSolver {
     pub fn step(&mut self, model: &Model, loads: &Loads, state: &mut State, stage: Stage, constraints: Constraints<'_, '_>) -> Result<StepInfo, StepError> {
         let dynamic = stage == Stage::Dynamic;
         let (alpha, beta) = self.external_forces_of_step(model, loads, state, stage, constraints);
-        self.internal_forces_of_step(model, state, beta, constraints);
-        let (sums, info) = self.update_into(model, state, StepCoefficients { alpha, beta, dynamic }, constraints)?;
+        let k = StepCoefficients { alpha, beta, dynamic, grouped: dynamic && !self.pairs.is_empty() };
+        if k.grouped {
+            self.pair_internal_forces_of_step(model, state, constraints);
+        } else {
+            self.internal_forces_of_step(model, state, beta, constraints);
+        }
+        let (sums, info) = self.update_into(model, state, k, constraints)?;
         if dynamic {
             add_step_energy(&mut state.energy, sums, &info);
         }
         if !sums[3].is_finite() {
             return Err(self.non_finite_error(model, state));
         }
-        self.shift_into(state, beta);
+        self.shift_into(state, k.stiffness());
         if dynamic && (state.step % self.energy_stride == 0) {
             self.check_energy(model, state)?;
         }
@@ -291,6 +331,22 @@ impl ExplicitSolver {
         }
     }
 
+    /// With the pairs' β apart ([`Model::beta_grouped`]): per pair p, f_p = K_p(u[n] + β_p v_b)
+    /// and K_p u[n] by the one-β recursion; `f_int` = Σ f_p, `ku` = Σ K_p u[n]. The elements are
+    /// visited once in all (each pair's loop skips the other's), the nodal passes once per pair.
+    fn pair_internal_forces_of_step(&mut self, model: &Model, state: &State, constraints: Constraints<'_, '_>) {
+        for p in self.pairs.iter_mut() {
+            let c = p.beta / self.dt;
+            for_each_entry(&mut self.w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
+            pair_forces_into(model, constraints, p.rock, &self.w, &mut p.f);
+            let (f, ku_prev) = (&p.f, &p.ku_prev);
+            for_each_entry(&mut p.ku, |i, k| *k = (f[i] + c * ku_prev[i]) / (1.0 + c));
+        }
+        let (a, b) = (&self.pairs[0], &self.pairs[1]);
+        for_each_entry(&mut self.f_int, |i, f| *f = a.f[i] + b.f[i]);
+        for_each_entry(&mut self.ku, |i, k| *k = a.ku[i] + b.ku[i]);
+    }
+
     /// u[n+1] into `u_next`: the prediction, one block of nodes per task, the block nodes,
     /// then the constraints' corrections. Returns the energy increments W_ext, D_α, D_β and
     /// the finiteness probe ([`StepTerms::increments`]) and the corrections' information. With
@@ -315,7 +371,7 @@ impl ExplicitSolver {
             info.correction = std::mem::take(&mut info.correction).merged(ci);
         }
         let mut s = sum_blocks(self.u_next.len(), |r| terms.increments(r.clone(), &self.u_next[r]));
-        if k.dynamic && k.alpha > 0.0 {
+        if k.dynamic {
             terms.add_block_mass_damping(&self.u_next, &mut s[1]);
         }
         Ok((s, info))
@@ -335,11 +391,14 @@ impl ExplicitSolver {
         }
     }
 
-    /// The end of a step: K u[n] becomes K u[n−1] (β > 0); u_nm1 ← u[n−1], u_prev ← u[n],
-    /// u ← u[n+1]; the step index and t advance.
-    fn shift_into(&mut self, state: &mut State, beta: f64) {
-        if beta > 0.0 {
+    /// The end of a step: K u[n] becomes K u[n−1] (with βK; per pair too); u_nm1 ← u[n−1],
+    /// u_prev ← u[n], u ← u[n+1]; the step index and t advance.
+    fn shift_into(&mut self, state: &mut State, stiffness: bool) {
+        if stiffness {
             std::mem::swap(&mut self.ku, &mut self.ku_prev);
+            for p in self.pairs.iter_mut() {
+                std::mem::swap(&mut p.ku, &mut p.ku_prev);
+            }
         }
         std::mem::swap(&mut self.u_nm1, &mut state.u_prev);
         std::mem::swap(&mut state.u_prev, &mut state.u);
@@ -353,8 +412,11 @@ impl ExplicitSolver {
         self.u_nm1.copy_from_slice(&state.u_prev);
         // K u into the scratch u_next (overwritten by the next step)
         model.internal_forces_into(&state.u, &mut self.u_next);
-        if model.beta > 0.0 {
+        if model.stiffness_damped() {
             self.ku_prev.copy_from_slice(&self.u_next);
+        }
+        for p in self.pairs.iter_mut() {
+            model.internal_forces_of_pair_into(p.rock, false, &state.u, &mut p.ku_prev);
         }
         let se = 0.5 * state.u.iter().zip(&self.u_next).map(|(u, f)| u * f).sum::<f64>();
         state.energy = Energy { strain: se, initial: se, scale: se.abs(), ..Energy::default() };
@@ -373,7 +435,7 @@ impl ExplicitSolver {
         let dt = self.dt;
         // K u[n]: the step's internal force when β = 0, else the recovered one (after the swap
         // at the end of the step it sits in ku_prev)
-        let ku: &[f64] = if model.beta > 0.0 { &self.ku_prev } else { &self.f_int };
+        let ku: &[f64] = if model.stiffness_damped() { &self.ku_prev } else { &self.f_int };
         let [ke, se_mixed, se] = sum_blocks(state.u.len(), |r| {
             let (mut ke, mut se_mixed, mut se) = (0.0, 0.0, 0.0);
             for i in r {
@@ -437,12 +499,22 @@ impl ExplicitSolver {
     }
 }
 
-/// The damping of a step's stage (α [1/s], β [s]) and whether it is the dynamic stage.
+/// The damping of a step's stage (α [1/s]: the relaxation's on every node, in the dynamic stage
+/// each node's [`Model::node_alpha`]; β [s]: the one β, or with `grouped` each pair's,
+/// [`PairForces`]) and whether it is the dynamic stage.
 #[derive(Clone, Copy, Debug)]
 struct StepCoefficients {
     alpha: f64,
     beta: f64,
     dynamic: bool,
+    grouped: bool,
+}
+
+impl StepCoefficients {
+    /// Whether the step carries βK (`f_int` − `ku` is its force).
+    fn stiffness(&self) -> bool {
+        self.beta > 0.0 || self.grouped
+    }
 }
 
 /// What the update of one step reads: u[n], u[n−1], the forces at t[n] (K u[n] in `ku` when
@@ -464,7 +536,7 @@ impl StepTerms<'_> {
     /// Σ u[n+1]·0 (non-finite when some u[n+1] is), over the entries `r`; `u_next` holds the
     /// entries from r.start on.
     fn increments(&self, r: std::ops::Range<usize>, u_next: &[f64]) -> [f64; 4] {
-        let (dt, alpha, beta) = (self.dt, self.k.alpha, self.k.beta);
+        let (dt, stiffness) = (self.dt, self.k.stiffness());
         let (mut wext, mut damp, mut sdamp, mut finite) = (0.0, 0.0, 0.0, 0.0);
         let first = r.start;
         for i in r {
@@ -473,10 +545,11 @@ impl StepTerms<'_> {
             if self.k.dynamic {
                 let du = 0.5 * (un - self.u_prev[i]);
                 wext += du * self.f_ext[i];
-                if beta > 0.0 {
+                if stiffness {
                     sdamp += du * (self.f_int[i] - self.ku[i]);
                 }
-                if alpha > 0.0 && self.model.mass_damped[i / 3] {
+                let alpha = self.model.node_alpha[i / 3];
+                if alpha > 0.0 {
                     let vb = (self.u[i] - self.u_prev[i]) / dt;
                     damp += du * alpha * self.model.mass.inertial[i / 3] * vb;
                 }
@@ -503,7 +576,7 @@ impl StepTerms<'_> {
                     continue;
                 }
                 let vb = (self.u[i] - self.u_prev[i]) / dt;
-                let an = if self.k.dynamic && !model.mass_damped[node] { 0.0 } else { self.k.alpha };
+                let an = if self.k.dynamic { model.node_alpha[node] } else { self.k.alpha };
                 let a = (self.f_ext[i] - self.f_int[i]) / m - an * vb;
                 unode[c] = 2.0 * self.u[i] - self.u_prev[i] + dt2 * a;
             }
@@ -521,7 +594,7 @@ impl StepTerms<'_> {
             let i0 = 3 * node;
             let f = nalgebra::Vector3::from_fn(|c, _| self.f_ext[i0 + c] - self.f_int[i0 + c]);
             let a = b.inverse * f;
-            let an = if self.k.dynamic && !model.mass_damped[node] { 0.0 } else { self.k.alpha };
+            let an = if self.k.dynamic { model.node_alpha[node] } else { self.k.alpha };
             for c in 0..3 {
                 let i = i0 + c;
                 u_next[i] = if self.held[node] & (1 << c) != 0 {
@@ -534,15 +607,15 @@ impl StepTerms<'_> {
         }
     }
 
-    /// Mass damping of the added inertia A of the damped block nodes, Δu_c · α A v_b, added
-    /// to `damp` node by node.
+    /// Mass damping of the added inertia A of the damped block nodes, Δu_c · α A v_b (α the
+    /// node's), added to `damp` node by node.
     fn add_block_mass_damping(&self, u_next: &[f64], damp: &mut f64) {
         let dt = self.dt;
-        for b in self.model.mass.blocks.iter().filter(|b| self.model.mass_damped[b.node as usize]) {
+        for b in self.model.mass.blocks.iter().filter(|b| self.model.node_alpha[b.node as usize] > 0.0) {
             let i0 = 3 * b.node as usize;
             let du = nalgebra::Vector3::from_fn(|c, _| 0.5 * (u_next[i0 + c] - self.u_prev[i0 + c]));
             let vb = nalgebra::Vector3::from_fn(|c, _| (self.u[i0 + c] - self.u_prev[i0 + c]) / dt);
-            *damp += du.dot(&(b.added * vb)) * self.k.alpha;
+            *damp += du.dot(&(b.added * vb)) * self.model.node_alpha[b.node as usize];
         }
     }
 }

@@ -86,6 +86,10 @@ pub struct CriticalElement {
     /// or a cube, about 0 for a sliver, below [`crate::mesh::quality::SLIVER_SCALED_JACOBIAN`]
     /// the run warns).
     pub scaled_jacobian: f64,
+    /// The Rayleigh pair of its elements (α [1/s], β [s]): the scene's, or the rock's own
+    /// ([`Model::damping_of_material`]); the stable step is its damped step.
+    pub alpha: f64,
+    pub beta: f64,
     /// Its element step 2/ω over the mean element step of its block (the elements of its
     /// material group): how much smaller than the block's typical element's its step is (1 when
     /// every element of the block is alike).
@@ -103,6 +107,17 @@ impl CriticalElement {
     }
 }
 
+/// The rock's own Rayleigh pair (issue 29 §3; docs/dam_physics.md "Foundation models").
+#[derive(Clone, Debug)]
+pub struct RockRayleigh {
+    /// α [1/s] on the rock's nodes (those of no mass-damped group of the scene's) and β [s] on
+    /// the rock's elements.
+    pub alpha: f64,
+    pub beta: f64,
+    /// Per material: a rock material (its elements carry this pair).
+    pub material: Vec<bool>,
+}
+
 /// Everything that does not change during a run.
 #[derive(Debug)]
 pub struct Model {
@@ -117,12 +132,18 @@ pub struct Model {
     /// Components the explicit step does not integrate (u[n+1] = 0 in the prediction): the fixed
     /// ones, and all three of a node without inertia (set by a constraint instead).
     pub held: Vec<u8>,
-    /// Rayleigh damping C = αM + βK: α [1/s], β [s].
+    /// The scene's Rayleigh damping C = αM + βK: α [1/s], β [s]: every element's, unless the
+    /// rock has its own pair ([`Model::rock_damping`]).
     pub alpha: f64,
-    /// Per node: whether αM applies in the dynamic stage (scene `damping.mass_groups`; all
-    /// nodes by default). Relaxation damping applies to every node regardless.
-    pub mass_damped: Vec<bool>,
+    /// Per node: α [1/s] of the mass-proportional term αM in the dynamic stage
+    /// ([`node_alphas`]: the scene's α on the nodes of `damping.mass_groups`, all by default;
+    /// the rock's own α on the rock's other nodes). Relaxation damping applies to every node
+    /// regardless.
+    pub node_alpha: Vec<f64>,
     pub beta: f64,
+    /// The rock's own Rayleigh pair (scene `foundation.damping` given as a pair; issue 29 §3);
+    /// `None`: every element has the scene's (α, β).
+    pub rock_damping: Option<RockRayleigh>,
     pub critical: CriticalElement,
     /// Per material: a massless block (stiffness only; the foundation module condenses it).
     pub massless: Vec<bool>,
@@ -322,17 +343,30 @@ impl Model {
     /// faces (the massive layer of a massless block, [`joint_face_nodes`]), the elements and
     /// their lumped masses in cell order ([`ElementScan`]), the assembly order
     /// ([`ElementScan::take_sets`]), the supports ([`supports`]), the mass-scaling summary
-    /// ([`mass_scaling_summary`]), the mass-damped nodes ([`mass_damped_nodes`]), then the
-    /// critical element.
+    /// ([`mass_scaling_summary`]), the nodes' αM ([`node_alphas`]), then the critical element.
     pub fn build(mesh: Mesh, scene: &Scene) -> Result<Model, crate::Error> {
         let n = mesh.nodes.len();
         let (materials, owner) = material_owners(&mesh, scene)?;
         let (alpha, beta) = scene.damping.coefficients().map_err(ModelError::Invalid)?;
+        let rock_damping = rock_rayleigh(scene)?;
+        let pair_of = |mi: usize| match &rock_damping {
+            Some(r) if r.material[mi] => (r.alpha, r.beta),
+            _ => (alpha, beta),
+        };
         // mass scaling (scene time.mass_scaling): the element ω² above which an element's density
         // is scaled, its factor per mesh cell, and the scaled (inertial) nodal masses; `mass`
         // stays the unscaled one (the weight)
-        let target_w2 = match &scene.time.mass_scaling {
-            Some(ms) => Some(mass_scaling::target_omega2(ms.target_dt / scene.time.courant_or_default(), alpha, beta).map_err(ModelError::Invalid)?),
+        // (per material: its Rayleigh pair's)
+        let target_w2: Option<Vec<f64>> = match &scene.time.mass_scaling {
+            Some(ms) => Some(
+                (0..scene.materials.len())
+                    .map(|mi| {
+                        let (a, b) = pair_of(mi);
+                        mass_scaling::target_omega2(ms.target_dt / scene.time.courant_or_default(), a, b)
+                    })
+                    .collect::<Result<_, _>>()
+                    .map_err(ModelError::Invalid)?,
+            ),
             None => None,
         };
         let massless: Vec<bool> = scene.materials.iter().map(|m| m.massless).collect();
@@ -340,7 +374,7 @@ impl Model {
         let mut scan = ElementScan::new(n, mesh.cells.len(), target_w2.is_some());
         for (c, &mi) in owner.iter().enumerate() {
             if mi != u32::MAX {
-                scan.add_cell(&mesh, &materials, &massless, &joint_node, target_w2, c, mi as usize)?;
+                scan.add_cell(&mesh, &materials, &massless, &joint_node, target_w2.as_ref().map(|t| t[mi as usize]), c, mi as usize)?;
             }
         }
         drop(owner);
@@ -362,7 +396,7 @@ impl Model {
             inertial = Vec::new();
             mass_scale = Vec::new();
         }
-        let mass_damped = mass_damped_nodes(&mesh, scene)?;
+        let node_alpha = node_alphas(&mesh, scene, alpha, rock_damping.as_ref())?;
         let held = fixed.iter().zip(&mass).map(|(&f, &m)| if m > 0.0 { f } else { 7 }).collect();
         let mut model = Model {
             mesh,
@@ -382,9 +416,10 @@ impl Model {
             fixed,
             held,
             alpha,
-            mass_damped,
+            node_alpha,
             beta,
-            critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0, scaled_jacobian: 1.0, step_ratio: 1.0, mass_factor: 1.0 },
+            rock_damping,
+            critical: CriticalElement { tag: 0, group: String::new(), omega2: 0.0, alpha, beta, scaled_jacobian: 1.0, step_ratio: 1.0, mass_factor: 1.0 },
             massless,
             massless_cells: element_massless_cell,
             condensed,
@@ -430,9 +465,13 @@ impl Model {
         self.fixed[node] & (1 << comp) == 0
     }
 
-    /// The element with the largest ω²_max (element eigenvalue theorem: the global ω_max is bounded
-    /// by the largest element ω_max with lumped mass).
+    /// The element with the smallest damped step: per Rayleigh pair (the scene's, the rock's
+    /// own) the element with the largest ω²_max (element eigenvalue theorem: the global ω_max is
+    /// bounded by the largest element ω_max with lumped mass), and of those the one whose
+    /// [`damped_step`] with its pair is smaller (the scene's on a tie; with one pair, the largest
+    /// ω²_max).
     fn max_element_eigenvalue(&self) -> CriticalElement {
+        let group = |mi: usize| self.rock_damping.as_ref().is_some_and(|r| r.material[mi]) as usize;
         // an element of a massless block sets no stable step (its nodes are condensed, or carry
         // the mass of other elements: the foundation's bound on them is the foundation module's);
         // its layer elements along a joint have their mass and count as usual
@@ -450,11 +489,14 @@ impl Model {
                 if m.rho > 0.0 { tet4::max_eigenvalue(&g.grad, g.vol, m.rho, &m.lame) / self.scale_of(self.tets.cell[e]) } else { 0.0 }
             })
             .collect();
-        let mut t = (0.0, 0, 0);
+        // per pair: (ω², cell, material) of its element with the largest ω²
+        let mut best = [(0.0, 0, 0); 2];
         for (e, &w) in tet_omega.iter().enumerate() {
             let c = self.tets.cell[e] as usize;
+            let mi = self.tets.mat[e] as usize;
+            let t = &mut best[group(mi)];
             if w > t.0 || (w == t.0 && c < t.1) {
-                t = (w, c, self.tets.mat[e] as usize);
+                *t = (w, c, mi);
             }
         }
         // shapes are shared: one eigenvalue per (shape), with the material of its first element
@@ -475,17 +517,23 @@ impl Model {
                 if m.rho > 0.0 { hex8::max_eigenvalue(s, m.rho, &m.lame) } else { 0.0 }
             })
             .collect();
-        let mut best = t;
         for e in 0..self.hexes.nodes.len() {
             if pure_massless(self.hexes.cell[e]) {
                 continue;
             }
             let w = shape_omega[self.hexes.shape[e] as usize] / self.scale_of(self.hexes.cell[e]);
             let c = self.hexes.cell[e] as usize;
-            if w > best.0 || (w == best.0 && c < best.1) {
-                best = (w, c, self.hexes.mat[e] as usize);
+            let mi = self.hexes.mat[e] as usize;
+            let b = &mut best[group(mi)];
+            if w > b.0 || (w == b.0 && c < b.1) {
+                *b = (w, c, mi);
             }
         }
+        let step_of = |b: &(f64, usize, usize)| {
+            let (a, bt) = self.damping_of_material(b.2);
+            damped_step(b.0, a, bt)
+        };
+        let best = if best[1].0 > 0.0 && step_of(&best[1]) < step_of(&best[0]) { best[1] } else { best[0] };
         // the mean element step 2/ω of the critical element's block (its material's elements
         // that set a step)
         let (mut sum, mut count) = (0.0, 0usize);
@@ -508,7 +556,8 @@ impl Model {
         let step_ratio = if best.0 > 0.0 && count > 0 { (2.0 / best.0.sqrt()) / (sum / count as f64) } else { 1.0 };
         let scaled_jacobian = crate::mesh::quality::cell_scaled_jacobian(&self.mesh, best.1).unwrap_or(1.0);
         let mass_factor = self.scale_of(best.1 as u32);
-        CriticalElement { tag: self.mesh.cells[best.1].tag, group: self.materials[best.2].group.clone(), omega2: best.0, scaled_jacobian, step_ratio, mass_factor }
+        let (alpha, beta) = self.damping_of_material(best.2);
+        CriticalElement { tag: self.mesh.cells[best.1].tag, group: self.materials[best.2].group.clone(), omega2: best.0, alpha, beta, scaled_jacobian, step_ratio, mass_factor }
     }
 
     /// The inertial density factor of mesh cell `cell` (1 without mass scaling).
@@ -517,42 +566,72 @@ impl Model {
         self.mass_scale.get(cell as usize).copied().unwrap_or(1.0)
     }
 
-    /// Stable time step [s] of the central-difference scheme with Rayleigh damping:
-    /// the largest dt with ω²dt² + 2(α + βω²) dt − 4 ≤ 0 at ω = ω_max (undamped: 2/ω_max).
-    /// Infinite when no element has mass (nothing to integrate explicitly).
+    /// Stable time step [s] of the central-difference scheme with Rayleigh damping: the
+    /// [`damped_step`] of the critical element with its pair. Infinite when no element has
+    /// mass (nothing to integrate explicitly).
     pub fn stable_dt(&self) -> f64 {
-        let w2 = self.critical.omega2;
-        if w2 <= 0.0 {
-            return f64::INFINITY;
-        }
-        let c = self.alpha + self.beta * w2;
-        (-c + (c * c + 4.0 * w2).sqrt()) / w2
+        damped_step(self.critical.omega2, self.critical.alpha, self.critical.beta)
     }
 
-    /// Stable step with an extra ω² bound `extra_omega2` [1/s²] added to the element bound
-    /// (λ_max(A + B) ≤ λ_max(A) + λ_max(B)), e.g. for penalty springs.
+    /// Stable step with an extra ω² bound `extra_omega2` [1/s²] added to the critical element's
+    /// bound (λ_max(A + B) ≤ λ_max(A) + λ_max(B)), e.g. for penalty springs, with its pair.
     pub fn stable_dt_with(&self, extra_omega2: f64) -> f64 {
-        let w2 = self.critical.omega2 + extra_omega2;
-        if w2 <= 0.0 {
-            return f64::INFINITY;
+        damped_step(self.critical.omega2 + extra_omega2, self.critical.alpha, self.critical.beta)
+    }
+
+    /// (α [1/s], β [s]) of material `mi`'s elements: the rock's own pair on the rock's
+    /// materials ([`Model::rock_damping`]), else the scene's.
+    pub fn damping_of_material(&self, mi: usize) -> (f64, f64) {
+        match &self.rock_damping {
+            Some(r) if r.material[mi] => (r.alpha, r.beta),
+            _ => (self.alpha, self.beta),
         }
-        let c = self.alpha + self.beta * w2;
-        (-c + (c * c + 4.0 * w2).sqrt()) / w2
+    }
+
+    /// Whether the elements' β differ (the rock's own β is not the scene's): the explicit step
+    /// then forms βK per pair ([`Model::internal_forces_of_pair_into`]); otherwise one β,
+    /// [`Model::beta`], applies everywhere.
+    pub fn beta_grouped(&self) -> bool {
+        self.rock_damping.as_ref().is_some_and(|r| r.beta != self.beta)
+    }
+
+    /// Whether some element carries βK.
+    pub fn stiffness_damped(&self) -> bool {
+        self.beta > 0.0 || self.rock_damping.as_ref().is_some_and(|r| r.beta > 0.0)
     }
 
     /// f = K u (f is overwritten). Deterministic whatever the thread count.
     pub fn internal_forces_into(&self, u: &[f64], f: &mut [f64]) {
-        self.internal_forces_where_into::<false>(u, f)
+        self.internal_forces_where_into::<false, 0>(u, f)
     }
 
     /// f = K u of the elements that carry mass: the elements of massless blocks
     /// ([`Model::massless_cells`]) left out, for a step that applies the condensed foundation's
     /// Schur complement instead (`foundation`). Same order and sums otherwise.
     pub fn internal_forces_of_massive_into(&self, u: &[f64], f: &mut [f64]) {
-        self.internal_forces_where_into::<true>(u, f)
+        self.internal_forces_where_into::<true, 0>(u, f)
     }
 
-    fn internal_forces_where_into<const SKIP_MASSLESS: bool>(&self, u: &[f64], f: &mut [f64]) {
+    /// f = K_p u of the elements of one Rayleigh pair alone (`rock`: the rock's own,
+    /// [`Model::rock_damping`]; else the scene's), the elements of massless blocks left out with
+    /// `skip_massless`: the step's βK per pair when the pairs' β differ
+    /// ([`Model::beta_grouped`]). Same order and sums as [`Model::internal_forces_into`] on the
+    /// pair's elements.
+    pub fn internal_forces_of_pair_into(&self, rock: bool, skip_massless: bool, u: &[f64], f: &mut [f64]) {
+        match (rock, skip_massless) {
+            (false, false) => self.internal_forces_where_into::<false, 1>(u, f),
+            (false, true) => self.internal_forces_where_into::<true, 1>(u, f),
+            (true, false) => self.internal_forces_where_into::<false, 2>(u, f),
+            (true, true) => self.internal_forces_where_into::<true, 2>(u, f),
+        }
+    }
+
+    /// The element loop: `PAIR` 0 every element, 1 those of the scene's Rayleigh pair, 2 the
+    /// rock's own ([`Model::internal_forces_of_pair_into`]).
+    fn internal_forces_where_into<const SKIP_MASSLESS: bool, const PAIR: u8>(&self, u: &[f64], f: &mut [f64]) {
+        let rock_material: &[bool] = self.rock_damping.as_ref().map_or(&[], |r| &r.material);
+        // whether material `mi`'s elements are left out (PAIR 0: never)
+        let other_pair = |mi: u16| PAIR != 0 && rock_material.get(mi as usize).copied().unwrap_or(false) != (PAIR == 2);
         if f.len() < 4 * NODAL_BLOCK {
             f.fill(0.0);
         } else {
@@ -571,7 +650,7 @@ impl Model {
             std::hint::black_box(s);
         };
         self.tets.schedule.for_each_element(warm, |e| {
-            if SKIP_MASSLESS && self.massless_cells[self.tets.cell[e] as usize] {
+            if (SKIP_MASSLESS && self.massless_cells[self.tets.cell[e] as usize]) || other_pair(self.tets.mat[e]) {
                 return;
             }
             let nd = &self.tets.nodes[e];
@@ -594,7 +673,7 @@ impl Model {
             }
         });
         self.hexes.schedule.for_each_element(warm, |e| {
-            if SKIP_MASSLESS && self.massless_cells[self.hexes.cell[e] as usize] {
+            if (SKIP_MASSLESS && self.massless_cells[self.hexes.cell[e] as usize]) || other_pair(self.hexes.mat[e]) {
                 return;
             }
             let nd = &self.hexes.nodes[e];
@@ -943,20 +1022,61 @@ fn mass_scaling_summary(mesh: &Mesh, scene: &Scene, mass_scale: &[f64], mass: &[
     })
 }
 
-/// The nodes that carry the mass-proportional damping: all, or those of the scene's
-/// `damping.mass_groups` (volume groups).
-fn mass_damped_nodes(mesh: &Mesh, scene: &Scene) -> Result<Vec<bool>, crate::Error> {
-    Ok(match &scene.damping.mass_groups {
-        None => vec![true; mesh.nodes.len()],
-        Some(groups) => {
-            let mut d = vec![false; mesh.nodes.len()];
-            for g in groups {
-                mesh.group_of_dim(g, 3)?;
-                for node in mesh.group_nodes(g)? {
-                    d[node] = true;
-                }
+/// The central-difference stable step [s] at ω² `w2` [1/s²] with Rayleigh α [1/s], β [s]: the
+/// largest dt with ω²dt² + 2(α + βω²) dt − 4 ≤ 0 (undamped: 2/ω); infinite for ω² ≤ 0. The one
+/// rule for every element group's step (the model's, the massed rock's note).
+pub fn damped_step(w2: f64, alpha: f64, beta: f64) -> f64 {
+    if w2 <= 0.0 {
+        return f64::INFINITY;
+    }
+    let c = alpha + beta * w2;
+    (-c + (c * c + 4.0 * w2).sqrt()) / w2
+}
+
+/// The rock's own Rayleigh pair from the scene's `foundation.damping` (`None` unless it gives
+/// one): the pair, and the rock's materials (`foundation.rock`, else those marked `massless`).
+/// A rock material still massless (the scene not passed through the massed foundation's
+/// `scene_for_model`, or a massless foundation) is an error naming the field.
+fn rock_rayleigh(scene: &Scene) -> Result<Option<RockRayleigh>, ModelError> {
+    let Some(f) = &scene.foundation else { return Ok(None) };
+    let Some((alpha, beta)) = f.damping.own_pair().map_err(ModelError::Invalid)? else { return Ok(None) };
+    let rock: Vec<&str> = f.rock_materials(&scene.materials).iter().map(|m| m.group.as_str()).collect();
+    if let Some(m) = scene.materials.iter().find(|m| m.massless && rock.contains(&m.group.as_str())) {
+        return Err(ModelError::Invalid(format!(
+            "foundation.damping: the rock's own Rayleigh pair needs a massed rock, but its material \"{}\" is massless (condensed: no velocity to damp): set foundation.model to \"massed_fixed\" or \"radiating\" (built by Problem::build), or leave foundation.damping out",
+            m.group
+        )));
+    }
+    if let Some(g) = scene.damping.mass_groups.iter().flatten().find(|g| rock.contains(&g.as_str())) {
+        return Err(ModelError::Invalid(format!("damping.mass_groups names the rock's group \"{g}\", which has its own pair in foundation.damping: leave it out of damping.mass_groups")));
+    }
+    Ok(Some(RockRayleigh { alpha, beta, material: scene.materials.iter().map(|m| rock.contains(&m.group.as_str())).collect() }))
+}
+
+/// α [1/s] of every node's mass-proportional term in the dynamic stage: the scene's `alpha` on
+/// the nodes of `damping.mass_groups` (volume groups; default every node, or with the rock's
+/// own pair every node of a non-rock material), the rock's own α on the rock's other nodes
+/// (where the rock meets the dam the dam's α holds), 0 elsewhere.
+fn node_alphas(mesh: &Mesh, scene: &Scene, alpha: f64, rock: Option<&RockRayleigh>) -> Result<Vec<f64>, crate::Error> {
+    let n = mesh.nodes.len();
+    let mark = |groups: &mut dyn Iterator<Item = &String>| -> Result<Vec<bool>, crate::Error> {
+        let mut d = vec![false; n];
+        for g in groups {
+            mesh.group_of_dim(g, 3)?;
+            for node in mesh.group_nodes(g)? {
+                d[node] = true;
             }
-            d
         }
-    })
+        Ok(d)
+    };
+    let (scene_set, rock_set) = match rock {
+        None => (if let Some(g) = &scene.damping.mass_groups { mark(&mut g.iter())? } else { vec![true; n] }, vec![false; n]),
+        Some(r) => {
+            let of = |is_rock: bool| scene.materials.iter().zip(&r.material).filter(move |(_, x)| **x == is_rock).map(|(m, _)| &m.group);
+            let scene_set = if let Some(g) = &scene.damping.mass_groups { mark(&mut g.iter())? } else { mark(&mut of(false))? };
+            (scene_set, mark(&mut of(true))?)
+        }
+    };
+    let rock_alpha = rock.map_or(0.0, |r| r.alpha);
+    Ok(scene_set.iter().zip(&rock_set).map(|(&d, &r)| if d { alpha } else if r { rock_alpha } else { 0.0 }).collect())
 }

@@ -9,7 +9,7 @@
 //! boundary faces, and the records taken as the surface free field, deconvolved through a 1-D
 //! column (`crate::motion::column`) and applied as effective forces on the far faces.
 
-use super::MaterialSpec;
+use super::{Damping, MaterialSpec};
 use serde::{Deserialize, Serialize};
 
 /// The rock model (see the module doc).
@@ -37,12 +37,12 @@ impl FoundationModel {
     }
 }
 
-/// The massed rock's Rayleigh damping, a group of its own (issue 29 §3; docs/dam_physics.md
-/// "Foundation models"). The explicit step applies one pair (α, β) of the scene's `damping`:
+/// The massed rock's Rayleigh damping (issue 29 §3; docs/dam_physics.md "Foundation models").
+/// With "as_dam" and "stiffness_only" the explicit step applies the scene's one pair (α, β):
 /// βK on every element, αM on the nodes of `damping.mass_groups`; the rock's choice is whether
-/// its nodes carry αM.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
-#[serde(rename_all = "snake_case")]
+/// its nodes carry αM. A pair of its own (`Own`) gives the rock's elements their own β and the
+/// rock's nodes their own α (`Model::rock_damping`).
+#[derive(Clone, Debug, Default)]
 pub enum RockDamping {
     /// The scene's Rayleigh pair on the rock as on the dam (its volume groups join
     /// `damping.mass_groups`). Default. Why: with βK alone the dam study's β = 3.0e-5 s (5 % at
@@ -51,20 +51,86 @@ pub enum RockDamping {
     /// the default dam) next to the dam's f1 (0.85–1.1 Hz) is then undamped: the massed_fixed
     /// run of the last `make dam` grew to 8.2 m at the crest (docs/dam_physics.md). The dam's
     /// ratio (5 % at 1.5 Hz, 6–7.5 % at 1 Hz with α = 0.94 1/s) is the one damping of the whole
-    /// dam–rock system, as the seed's single ratio intends.
+    /// dam–rock system, as the seed's single ratio intends; and every run made before the
+    /// rock's own pair existed keeps its numbers bit for bit.
     #[default]
     AsDam,
-    /// βK only, the rock left out of αM (the state before this option; a lower bound of the
+    /// βK only, the rock left out of αM (the state before "as_dam"; a lower bound of the
     /// rock's damping). Needs `damping.mass_groups` naming the dam's groups (otherwise every
     /// node carries αM and the rock cannot be left out).
     StiffnessOnly,
+    /// The rock's own Rayleigh pair, written as the scene's `damping` (`{"ratio", "f1", "f2"}`
+    /// or `{"alpha", "beta"}`; the same rule [`Damping::coefficients`] turns it into (α, β);
+    /// no `mass_groups`: the rock's nodes carry its α, except those of the dam's mass-damped
+    /// groups). A rock's material damping (1–3 %, e.g. 2 % from its first mode up) apart from
+    /// the concrete's 5 %.
+    Own(Damping),
 }
 
 impl RockDamping {
-    pub fn as_str(self) -> &'static str {
+    pub fn as_str(&self) -> &'static str {
         match self {
             RockDamping::AsDam => "as_dam",
             RockDamping::StiffnessOnly => "stiffness_only",
+            RockDamping::Own(_) => "own pair",
+        }
+    }
+
+    /// The rock's own (α [1/s], β [s]) (`None` for "as_dam" and "stiffness_only"); an error
+    /// names the field and the fix.
+    pub fn own_pair(&self) -> Result<Option<(f64, f64)>, String> {
+        match self {
+            RockDamping::Own(d) => d.coefficients().map(Some).map_err(|e| format!("foundation.{e}")),
+            _ => Ok(None),
+        }
+    }
+
+    /// The checks of the rock's own pair that need no mesh: the scene's `damping` rule, and
+    /// no `mass_groups`, and `f1` < `f2` (the band between them is where the ratio holds).
+    fn validate(&self) -> Result<(), String> {
+        let RockDamping::Own(d) = self else { return Ok(()) };
+        self.own_pair()?;
+        if d.mass_groups.is_some() {
+            return Err("foundation.damping.mass_groups: the rock's pair applies to the rock's nodes; leave mass_groups out (the dam's are the scene's damping.mass_groups)".into());
+        }
+        if let (Some(f1), Some(f2)) = (d.f1, d.f2) {
+            if f2 <= f1 {
+                return Err(format!("foundation.damping: f2 = {f2} Hz must be above f1 = {f1} Hz (the ratio holds at both and below it between them: give f1 near the rock's first mode and f2 above it)"));
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<'de> Deserialize<'de> for RockDamping {
+    /// `"as_dam"`, `"stiffness_only"`, or an object of the scene's `damping` form.
+    fn deserialize<D: serde::Deserializer<'de>>(de: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = RockDamping;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"as_dam\", \"stiffness_only\", or the rock's own Rayleigh pair {\"ratio\", \"f1\", \"f2\"} or {\"alpha\", \"beta\"}")
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<RockDamping, E> {
+                match v {
+                    "as_dam" => Ok(RockDamping::AsDam),
+                    "stiffness_only" => Ok(RockDamping::StiffnessOnly),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
+                }
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<RockDamping, A::Error> {
+                Damping::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(RockDamping::Own)
+            }
+        }
+        de.deserialize_any(V)
+    }
+}
+
+impl Serialize for RockDamping {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            RockDamping::Own(d) => d.serialize(s),
+            other => s.serialize_str(other.as_str()),
         }
     }
 }
@@ -105,8 +171,8 @@ pub struct FoundationScene {
     /// model and only the dam's loads strain the rock.
     #[serde(default)]
     pub rock_weight: bool,
-    /// The massed rock's damping ([`RockDamping`]): "as_dam" (default) or "stiffness_only".
-    /// Nothing for the massless rock (condensed statically: no velocity to damp).
+    /// The massed rock's damping ([`RockDamping`]): "as_dam" (default), "stiffness_only" or the
+    /// rock's own pair. Nothing for the massless rock (condensed statically: no velocity to damp).
     #[serde(default)]
     pub damping: RockDamping,
 }
@@ -150,9 +216,14 @@ impl FoundationScene {
             }
             Ok(())
         };
-        if self.damping != RockDamping::AsDam && !self.model.massed() {
-            return Err(format!("foundation.damping \"{}\": only with a massed rock (\"massed_fixed\" or \"radiating\"; the model is \"{}\")", self.damping.as_str(), self.model.as_str()));
+        if !matches!(self.damping, RockDamping::AsDam) && !self.model.massed() {
+            return Err(format!(
+                "foundation.damping \"{}\": only with a massed rock (\"model\": \"massed_fixed\" or \"radiating\"; the model is \"{}\", whose condensed rock has no velocity to damp): set the model or leave foundation.damping out",
+                self.damping.as_str(),
+                self.model.as_str()
+            ));
         }
+        self.damping.validate()?;
         radiating_only(self.springs, "springs")?;
         radiating_only(self.spring_distance.is_some(), "spring_distance")?;
         radiating_only(self.surface.is_some(), "surface")?;

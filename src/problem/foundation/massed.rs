@@ -29,11 +29,11 @@ pub fn scene_for_model(mut scene: Scene) -> Scene {
     let rock: Vec<String> = f.rock_materials(&scene.materials).iter().map(|m| m.group.clone()).collect();
     // the rock named explicitly: its materials are no longer marked massless
     f.rock = Some(rock.clone());
-    let damping = f.damping;
+    let as_dam = matches!(f.damping, RockDamping::AsDam);
     for m in scene.materials.iter_mut().filter(|m| rock.contains(&m.group)) {
         m.massless = false;
     }
-    if let (RockDamping::AsDam, Some(groups)) = (damping, scene.damping.mass_groups.as_mut()) {
+    if let (true, Some(groups)) = (as_dam, scene.damping.mass_groups.as_mut()) {
         for g in &rock {
             if !groups.contains(g) {
                 groups.push(g.clone());
@@ -71,13 +71,15 @@ fn rock_critical(model: &Model, rock_groups: &[String]) -> (f64, u64) {
     best
 }
 
-/// The central-difference stable step at ω² `w2` with Rayleigh α, β (as [`Model::stable_dt`]).
-fn stable_step(w2: f64, alpha: f64, beta: f64) -> f64 {
-    if w2 <= 0.0 {
-        return f64::INFINITY;
+/// The massed rock's Rayleigh pair (α [1/s], β [s]): its own ([`Model::rock_damping`]), the
+/// scene's with "as_dam", the scene's β alone with "stiffness_only". What its elements step
+/// with and what its free-field columns are damped by.
+fn rock_pair(model: &Model, f: &FoundationScene) -> (f64, f64) {
+    match (&model.rock_damping, &f.damping) {
+        (Some(r), _) => (r.alpha, r.beta),
+        (None, RockDamping::StiffnessOnly) => (0.0, model.beta),
+        _ => (model.alpha, model.beta),
     }
-    let c = alpha + beta * w2;
-    (-c + (c * c + 4.0 * w2).sqrt()) / w2
 }
 
 /// The far face groups: `far`'s names and patterns matched against the mesh's face groups.
@@ -138,16 +140,15 @@ pub fn prepare_loads(scene: &Scene, model: &Model, loads: &mut Loads, notes: &mu
         }
         loads.gravity_nodes = Some(mask);
     }
-    if f.damping == RockDamping::StiffnessOnly && scene.damping.mass_groups.is_none() && model.alpha > 0.0 {
+    if matches!(f.damping, RockDamping::StiffnessOnly) && scene.damping.mass_groups.is_none() && model.alpha > 0.0 {
         return Err(ModelError::Invalid("foundation.damping \"stiffness_only\": damping.mass_groups names no groups, so every node (the rock's too) carries αM; name the dam's volume groups there".into()).into());
     }
     let c = &model.critical;
     let groups: Vec<String> = f.rock_materials(&scene.materials).iter().map(|m| m.group.clone()).collect();
-    let damped = rock.nodes.first().is_some_and(|&n| model.mass_damped[n]);
-    let alpha = if damped { model.alpha } else { 0.0 };
+    let (alpha, beta) = rock_pair(model, f);
     let (w2, tag) = rock_critical(model, &groups);
     notes.push(format!(
-        "foundation {}: rock massed ({} nodes, ρ {} kg/m³, c_p {:.0} m/s, c_s {:.0} m/s){}; rock damping {} (α {alpha:.4} 1/s, β {:.3e} s: ξ {:.2} % at 1 Hz); the rock's own stable step {:.4e} s, set by its element {tag}; stable step of all elements {:.4e} s, set by element {} in \"{}\"",
+        "foundation {}: rock massed ({} nodes, ρ {} kg/m³, c_p {:.0} m/s, c_s {:.0} m/s){}; rock damping {} (α {alpha:.4} 1/s, β {beta:.3e} s: ξ {:.2} % at 1 Hz); the rock's own stable step {:.4e} s, set by its element {tag}; stable step of all elements {:.4e} s, set by element {} in \"{}\"",
         f.model.as_str(),
         rock.nodes.len(),
         rock.material.rho,
@@ -155,9 +156,8 @@ pub fn prepare_loads(scene: &Scene, model: &Model, loads: &mut Loads, notes: &mu
         (rock.material.lame.mu / rock.material.rho).sqrt(),
         if f.rock_weight { ", with its weight" } else { ", weightless (in-situ state predates the dam)" },
         f.damping.as_str(),
-        model.beta,
-        100.0 * (alpha / (4.0 * std::f64::consts::PI) + model.beta * std::f64::consts::PI),
-        stable_step(w2, alpha, model.beta),
+        100.0 * (alpha / (4.0 * std::f64::consts::PI) + beta * std::f64::consts::PI),
+        crate::model::damped_step(w2, alpha, beta),
         model.stable_dt(),
         c.tag,
         c.group
@@ -184,10 +184,10 @@ fn far_boundary(scene: &Scene, f: &FoundationScene, model: &Model, rock: &Rock<'
     if !(height > 0.0) {
         return Err(ModelError::Invalid(format!("foundation.surface = {surface} m is not above the rock's base (z = {} m)", lo[2])).into());
     }
-    let alpha = if rock.nodes.first().is_some_and(|&n| model.mass_damped[n]) { model.alpha } else { 0.0 };
+    let (alpha, beta) = rock_pair(model, f);
     let base = std::mem::take(&mut loads.base);
     let f_max = f.max_frequency.unwrap_or(super::free_field::DEFAULT_MAX_FREQUENCY);
-    let ff = FreeField::build(&base, rock.material, surface, height, alpha, model.beta, f_max);
+    let ff = FreeField::build(&base, rock.material, surface, height, alpha, beta, f_max);
     // components the far groups' boundary entries hold (and no other entry does)
     let mut far_bits = vec![0u8; model.n_nodes()];
     let mut other_bits = vec![0u8; model.n_nodes()];
@@ -214,14 +214,13 @@ fn far_boundary(scene: &Scene, f: &FoundationScene, model: &Model, rock: &Rock<'
     };
     let far = FarBoundary::build(&faces, ff, &released)?;
     notes.push(format!(
-        "foundation radiating: {} far faces ({} m², groups {}), {} nodes with Lysmer dashpots{}; free field from {} base record(s) as the surface motion at z = {surface} m, low-passed at {f_max} Hz and deconvolved through a {height:.1} m uniform column (vertical S for x, y; P for z; Rayleigh α {alpha:.4} 1/s, β {:.3e} s as the rock); the surface record plays at t − {:.3} s",
+        "foundation radiating: {} far faces ({} m², groups {}), {} nodes with Lysmer dashpots{}; free field from {} base record(s) as the surface motion at z = {surface} m, low-passed at {f_max} Hz and deconvolved through a {height:.1} m uniform column (vertical S for x, y; P for z; Rayleigh α {alpha:.4} 1/s, β {beta:.3e} s as the rock); the surface record plays at t − {:.3} s",
         far.faces,
         far.area,
         groups.join(", "),
         far.nodes.len(),
         if f.springs { " and springs (4/3, 2/3 G/R)" } else { "" },
         base.len(),
-        model.beta,
         far.free_field.delay
     ));
     Ok(far)
