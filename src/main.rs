@@ -247,6 +247,10 @@ struct TestcaseArgs {
     #[arg(long, allow_negative_numbers = true)]
     #[serde(skip_serializing_if = "Option::is_none")]
     curvature: Option<f64>,
+    /// Patch with --curvature: the slave's joint nodes on the exact cylinder too (default: on
+    /// the master's facets); the joint is then grouted whatever its method.
+    #[arg(long)]
+    slave_on_cylinder: bool,
     /// Output directory.
     #[arg(long)]
     #[serde(skip)]

@@ -121,50 +121,32 @@ pub fn master_surface_distances_into(master: &Surface, points: &[[f64; 3]], laye
     }
 }
 
-/// Distance [m] from point `p` to the triangle (a, b, c) (closest point by Voronoi regions,
-/// Ericson, Real-Time Collision Detection §5.1.5).
+/// Distance [m] from point `p` to the triangle (a, b, c): the closest point by Voronoi regions
+/// of [`crate::mesh::geometry::closest_on_triangle`] (Ericson, Real-Time Collision Detection
+/// §5.1.5), the one routine of the crate.
+///
+/// The point is rebuilt from the barycentric weights in the form of its region, as the tagger
+/// computed it when it had its own copy of the routine: a vertex itself, a point of edge ab or
+/// ac as a + (b − a) v or a + (c − a) w, of edge bc as b + (c − b) w, of the face as a + ((b −
+/// a) v + (c − a) w), v and w being the very weights the routine returns. The rebuilt point
+/// l₀ a + l₁ b + l₂ c would differ from those by round-off (of order 1e-16 of the face size),
+/// and the distances are the tagger's output (the tolerance check, `interface::write`'s joint files):
+/// this keeps them bit for bit (checked on the tagger's fixtures, the wedge and the contact
+/// bench's state hash). Only a face point whose weight lands on exactly 0 or 1 by round-off
+/// could take another form; both forms then are the same point to round-off.
 pub fn point_triangle_distance(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
     let (p, a, b, c) = (vec3(p), vec3(a), vec3(b), vec3(c));
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = ab.dot(&ap);
-    let d2 = ac.dot(&ap);
-    let dist = |q: Vector3<f64>| (p - q).norm();
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return dist(a);
-    }
-    let bp = p - b;
-    let d3 = ab.dot(&bp);
-    let d4 = ac.dot(&bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return dist(b);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return dist(a + ab * v);
-    }
-    let cp = p - c;
-    let d5 = ab.dot(&cp);
-    let d6 = ac.dot(&cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return dist(c);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return dist(a + ac * w);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return dist(b + (c - b) * w);
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    dist(a + (ab * v + ac * w))
+    let l = crate::mesh::geometry::closest_on_triangle(a, b, c, &p);
+    let q = match l {
+        [1.0, 0.0, 0.0] => a,
+        [0.0, 1.0, 0.0] => b,
+        [0.0, 0.0, 1.0] => c,
+        [_, v, 0.0] => a + (b - a) * v,
+        [_, 0.0, w] => a + (c - a) * w,
+        [0.0, _, w] => b + (c - b) * w,
+        [_, v, w] => a + ((b - a) * v + (c - a) * w),
+    };
+    (p - q).norm()
 }
 
 #[cfg(test)]

@@ -258,6 +258,15 @@ pub struct CaseSpec {
     /// tied. |R| > 0.5 m; default flat.
     #[serde(default)]
     pub curvature: Option<f64>,
+    /// Patch with `curvature`: the slave side's joint nodes on the exact cylinder too, as a
+    /// mesher puts both sides of a curved joint on the one CAD surface (default false: on the
+    /// master's facets). The two faceted surfaces then differ by the chords' sags, up to
+    /// h²/(8|R|) each (14 mm for h = 1/3 m, R = 1 m, against 0.5 mm of displacement under p), so
+    /// the joint, whatever its method, is grouted on the initial configuration ([`run`]). Both
+    /// sides then approximate the same exact surface to O(h²) at every level: the geometry of
+    /// the mortar convergence study (docs/validation.md §8). Default false.
+    #[serde(default)]
+    pub slave_on_cylinder: bool,
 }
 
 /// Patch material and geometry (module conventions).
@@ -308,6 +317,9 @@ pub struct Resolved {
     /// Patch: radius of the cylindrical joint [m] (see [`CaseSpec`]); None: flat.
     #[serde(default)]
     pub curvature: Option<f64>,
+    /// Patch: the slave side's joint nodes on the exact cylinder too (see [`CaseSpec`]).
+    #[serde(default)]
+    pub slave_on_cylinder: bool,
     /// Newmark: the record (absolute path) and its PGA [g].
     pub record: Option<PathBuf>,
     pub pga: f64,
@@ -435,13 +447,15 @@ impl CaseSpec {
         if total > 2_000_000 {
             return Err(invalid("lower/upper", format!("{total} elements: keep a case below 2 million")));
         }
-        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, pressure_first: self.pressure_first, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, record, pga })
+        Ok(Resolved { kind: k, lower, upper, slave, method, penalty, layer, mu, tied: self.tied, pressure, shear, inclination, massless_lower: self.massless_lower, pressure_first: self.pressure_first, duration, residual, edge_tolerance: self.edge_tolerance, offset, rotate, curvature: self.curvature, slave_on_cylinder: self.slave_on_cylinder, record, pga })
     }
 
     /// The cylindrical joint (`curvature` R), if any: a patch case, |R| above the joint's
     /// half-width, the pressure state only, and μ above the steepest slope unless tied.
     fn check_curvature(&self, k: Kind, mu: f64, pressure: f64, shear: f64, rotate: f64) -> Result<(), Error> {
-        let Some(rc) = self.curvature else { return Ok(()) };
+        let Some(rc) = self.curvature else {
+            return if self.slave_on_cylinder { Err(invalid("slave_on_cylinder", "only a cylindrical joint (curvature R) has the cylinder to put the slave's nodes on")) } else { Ok(()) };
+        };
         if k != Kind::Patch {
             return Err(invalid("curvature", "only the patch kind has a cylindrical joint"));
         }
@@ -481,6 +495,30 @@ impl Resolved {
         }
     }
 
+    /// The patch's exact normal (compressive) force through the joint [N]: ∫ n · σ n dA over
+    /// the exact joint surface, σzz = −p. Flat: p A (A = 1 m²). On the cylinder of radius R
+    /// (n_z = cos θ, dA = |R| dθ dy, |θ| ≤ α = asin(½ / |R|)): p |R| (α + sin α cos α) L_y
+    /// (0.95661 p at R = ±1 m).
+    pub fn exact_normal_force(&self) -> f64 {
+        let a = PATCH_SIDE;
+        match self.curvature {
+            Some(rc) => {
+                let al = (0.5 * a / rc.abs()).asin();
+                self.pressure * rc.abs() * (al + al.sin() * al.cos()) * a
+            }
+            None => self.pressure * a * a,
+        }
+    }
+
+    /// The patch's exact displacement at the local position `x` [m]: u = ((2τ/E) e_x − (p/E)
+    /// e_z)(z + H), the uniform state of ν = 0 with the base z = −H fixed (simple shear γ = 2τ/E
+    /// and the axial strain −p/E; module doc). Linear in x, so it is the exact displacement of
+    /// the meshed geometry as well as of the exact one.
+    pub fn exact_patch_displacement(&self, x: &Vector3<f64>) -> Vector3<f64> {
+        let s = x[2] + PATCH_HEIGHT;
+        Vector3::new(2.0 * self.shear / PATCH_E * s, 0.0, -self.pressure / PATCH_E * s)
+    }
+
     /// The slave's and master's face groups.
     pub fn joint_groups(&self) -> (&'static str, &'static str) {
         match self.slave {
@@ -517,6 +555,9 @@ impl Resolved {
         }
         if let Some(rc) = self.curvature {
             l += &format!(" cylinder R {rc}");
+            if self.slave_on_cylinder {
+                l += " both on it";
+            }
         }
         if self.pressure_first {
             l += " pressure first";
@@ -625,7 +666,7 @@ pub fn case_mesh(r: &Resolved) -> Result<Mesh, Error> {
 /// Bend the patch's joint into the cylinder of `curvature`: master nodes by f(x) (1 − |z|/H),
 /// slave nodes by g(x) (1 − |z|/H) with g the piecewise-linear interpolant of f at the master's
 /// joint node abscissae, so the slave's joint nodes lie on the master's facets (zero initial
-/// gap). Nodes `first_upper..` are the upper block's.
+/// gap), or by f too with `slave_on_cylinder`. Nodes `first_upper..` are the upper block's.
 fn curve_joint(r: &Resolved, mesh: &mut Mesh, first_upper: usize) -> Result<(), Error> {
     let h = PATCH_HEIGHT;
     let n = mesh.nodes.len();
@@ -649,7 +690,8 @@ fn curve_joint(r: &Resolved, mesh: &mut Mesh, first_upper: usize) -> Result<(), 
     }
     for i in slave {
         let x = &mut mesh.nodes[i];
-        x[2] += g(x[0]) * (1.0 - x[2].abs() / h);
+        let z = if r.slave_on_cylinder { r.joint_height(x[0]) } else { g(x[0]) };
+        x[2] += z * (1.0 - x[2].abs() / h);
     }
     if let Some(c) = (0..mesh.cells.len()).filter(|&c| matches!(mesh.cells[c].kind, crate::mesh::CellKind::Tet4 | crate::mesh::CellKind::Hex8)).find(|&c| !(mesh.min_corner_jacobian(c) > 0.0)) {
         let x = mesh.cells[c].nodes().iter().map(|&k| mesh.x(k as usize)).sum::<Vector3<f64>>() / mesh.cells[c].nodes().len() as f64;
@@ -774,6 +816,11 @@ pub fn case_scene(r: &Resolved) -> Value {
     }
     if let Some(e) = r.edge_tolerance {
         joint["edge_tolerance"] = json!(e);
+    }
+    if let (Some(rc), true) = (r.curvature, r.slave_on_cylinder) {
+        // a slave node on the cylinder lies off the master's chords by up to their sag
+        // h_m²/(8|R|): the tagger accepts twice that
+        joint["tolerance"] = json!(r.sizes().1.powi(2) / (4.0 * rc.abs()));
     }
     let (e, nu, rho) = match r.kind {
         Kind::Patch => (PATCH_E, 0.0, PATCH_RHO),

@@ -183,38 +183,77 @@ fn mortar_slide_newmark_and_impact_within_the_nts_errors() {
     }
 }
 
-/// Bounds of the cylindrical joint's σ error on hex 4/3, 8/6, 16/12: 1.25 × measured (2.90e-3,
-/// 1.53e-3, 6.85e-4).
-const BOUNDS_CYL: [f64; 3] = [3.63e-3, 1.92e-3, 8.56e-4];
+/// The cylindrical joint's three levels: hex 4/3 with 2 element layers per block, 8/6 with 4,
+/// 16/12 with 8 (every size halved: self-similar meshes), the finer lower side slave.
+const CYL_LEVELS: [(&str, &str); 3] = [("hex8:4:2", "hex8:3:2"), ("hex8:8:4", "hex8:6:4"), ("hex8:16:8", "hex8:12:8")];
+/// Measured on those levels (4 Dec 2026; [σ next to the joint, u L2] per level), mortar and NTS,
+/// slave nodes on the master's facets and both sides' nodes on the cylinder.
+const CYL_MORTAR_FACETS: [[f64; 2]; 3] = [[2.904e-3, 5.440e-3], [1.959e-3, 1.342e-3], [1.158e-3, 3.285e-4]];
+const CYL_MORTAR_ON: [[f64; 2]; 3] = [[4.741e-3, 4.745e-3], [2.387e-3, 1.174e-3], [1.380e-3, 2.874e-4]];
+const CYL_NTS_FACETS: [[f64; 2]; 3] = [[8.275e-2, 3.519e-2], [9.389e-2, 1.072e-2], [9.747e-2, 3.575e-3]];
+const CYL_NTS_ON: [[f64; 2]; 3] = [[8.459e-2, 3.860e-2], [9.652e-2, 1.152e-2], [9.879e-2, 3.787e-3]];
 /// Bound of the conforming cylinder's σ error (measured 1.3e-10, the static solve's residual).
 const CONFORMING_CYL: f64 = 1e-8;
 
-/// The cylindrical joint (R = 1 m, axis along y; the finer lower side slave) with mortar on three
-/// levels, hex 4/3, 8/6, 16/12 (h halved each time). Reference: the uniform σzz = −p of the
-/// patch kind, exact on the cylinder too (src/testcase/mod.rs). The slave's joint nodes sit on
-/// the master's facets and the mortar joint is grouted on that initial configuration: its
-/// weighted gap sees the two faceted surfaces apart by O(h H / R) where a slave face spans a
-/// master kink, and read as penetration that gave 149 / 120 / 54 % (src/testcase/run.rs).
-/// Measured σ error next to the joint 2.90e-3, 1.53e-3, 6.85e-4: observed orders 0.92 and 1.16,
-/// first order, not the O(h²) issue 31 asked for. The reason: with the faces kept paired, the
-/// tie of the linear exact field u leaves n · ∇u (x̄_j − x_j) per node, where x̄_j = Σ c_k x_k
-/// is the mortar image of the slave node, O(h H / R) off it on a faceted curve, so the strain
-/// error is O(h / R) (measured on hex 4/3: R = 1, 2, 4 m give 2.90e-3, 1.08e-3, 4.76e-4). Bounds:
-/// 1.25 × measured, and both observed orders above 0.8. The conforming cylinder is exact (the
-/// coincident faces give M_jk = D_jj δ_jk: a node-to-node tie).
+/// [σ next to the joint, u L2] of the cylindrical patch (R = 1 m) on the three levels.
+fn cylinder_levels(method: &str, slave_on_cylinder: bool) -> Vec<[f64; 2]> {
+    CYL_LEVELS
+        .iter()
+        .map(|(lower, upper)| {
+            let r = case(json!({"kind": "patch", "lower": lower, "upper": upper, "slave": "lower", "curvature": 1.0, "method": method, "slave_on_cylinder": slave_on_cylinder}));
+            match r.errors {
+                Errors::Patch { stress_joint, displacement_l2, .. } => [stress_joint, displacement_l2],
+                e => panic!("not a patch: {e:?}"),
+            }
+        })
+        .collect()
+}
+
+/// The cylindrical joint (R = 1 m, axis along y) under refinement, issue 31's check "error
+/// converging as O(h²)". Reference: the patch kind's uniform state σzz = −p, exact on the
+/// cylinder too, with its linear displacement u = −(p/E)(z + H) e_z, which is exact on the
+/// meshed (faceted) geometry as well, so any error is the joint's (src/testcase/mod.rs). Two
+/// geometries: the slave's joint nodes on the master's facets (the testcase's default), and both
+/// sides' nodes on the exact cylinder (`slave_on_cylinder`, as a mesher puts them; the two
+/// faceted surfaces then differ by the chords' sags at every level). Either way the two sides
+/// are different faceted surfaces O(h²/R) apart, grouted on the initial configuration.
+///
+/// What converges at second order is the **displacement** (the lumped-mass L2 norm of u −
+/// u_exact over the nodes / max |u_exact|), the quantity of the mortar theory for linear
+/// elements (Wohlmuth 2000: L2 displacement O(h²), energy norm O(h)) and the one a joint's
+/// opening and slip, the dam's outputs, are made of. Measured 5.44e-3, 1.34e-3, 3.29e-4 (facets)
+/// and 4.75e-3, 1.17e-3, 2.87e-4 (on the cylinder): observed orders 2.02, 2.03 and 2.01, 2.03.
+/// The tie of the linear exact field leaves n · ∇u (x̄_j − x_j) at each node (x̄_j the mortar
+/// image of the slave node, O(h²/R) off it): a displacement jump O(p h²/(E R)), hence a strain
+/// error O(h/R) in the elements at the joint: the σ error next to the joint converges at first
+/// order at best (facets 2.90e-3, 1.96e-3, 1.16e-3: orders 0.57, 0.76; on the cylinder
+/// 4.74e-3, 2.39e-3, 1.38e-3: 0.99, 0.79), the order of linear elements' stresses in general.
+/// NTS beside it, same levels: σ 8.3, 9.4, 9.7 % and 8.5, 9.7, 9.9 % (not converging), u L2
+/// 3.5e-2, 1.1e-2, 3.6e-3 (orders 1.71, 1.58) and 3.9e-2, 1.2e-2, 3.8e-3 (1.74, 1.60).
+/// Bounds: each error 1.25 × measured; mortar's L2 displacement orders within [1.8, 2.2] (the
+/// theory's 2; not tuned: both geometries gave 2.01–2.03), its σ orders within [0.4, 1.3]
+/// (first order, the geometric error above). The conforming cylinder is exact (the coincident
+/// faces give M_jk = D_jj δ_jk: a node-to-node tie).
 #[test]
-fn mortar_cylindrical_joint_converges_at_first_order() {
-    let mut e = Vec::new();
-    for (lower, upper) in [("hex8:4", "hex8:3"), ("hex8:8", "hex8:6"), ("hex8:16", "hex8:12")] {
-        let r = case(json!({"kind": "patch", "lower": lower, "upper": upper, "slave": "lower", "curvature": 1.0, "method": "mortar"}));
-        e.push(r.error);
-    }
+fn mortar_cylindrical_joint_displacements_converge_at_second_order() {
     let order = |a: f64, b: f64| (a / b).log2();
-    println!("MEASURED cylinder mortar σ errors {:.4e} {:.4e} {:.4e}, orders {:.2} {:.2}", e[0], e[1], e[2], order(e[0], e[1]), order(e[1], e[2]));
-    for (got, bound) in e.iter().zip(BOUNDS_CYL) {
-        assert!(*got < bound, "cylinder mortar errors {e:?} above {BOUNDS_CYL:?}");
+    let runs = [("mortar", false, CYL_MORTAR_FACETS), ("mortar", true, CYL_MORTAR_ON), ("nts", false, CYL_NTS_FACETS), ("nts", true, CYL_NTS_ON)];
+    for (method, on, measured) in runs {
+        let e = cylinder_levels(method, on);
+        let (s, u): (Vec<f64>, Vec<f64>) = e.iter().map(|x| (x[0], x[1])).unzip();
+        let sci = |v: &[f64]| v.iter().map(|x| format!("{x:.4e}")).collect::<Vec<_>>().join(", ");
+        println!("MEASURED cylinder {method} slave on cylinder {on}: σ {} (orders {:.2}, {:.2}), u L2 {} (orders {:.2}, {:.2})", sci(&s), order(s[0], s[1]), order(s[1], s[2]), sci(&u), order(u[0], u[1]), order(u[1], u[2]));
+        for (got, m) in e.iter().zip(measured) {
+            assert!(got[0] < 1.25 * m[0] && got[1] < 1.25 * m[1], "{method} on {on}: [σ, u L2] {e:?} above 1.25 × {measured:?}");
+        }
+        if method == "mortar" {
+            for k in 0..2 {
+                let (os, ou) = (order(s[k], s[k + 1]), order(u[k], u[k + 1]));
+                assert!((1.8..=2.2).contains(&ou), "mortar on {on}: u L2 order {ou:.2} outside [1.8, 2.2] ({u:?})");
+                assert!((0.4..=1.3).contains(&os), "mortar on {on}: σ order {os:.2} outside [0.4, 1.3] ({s:?})");
+            }
+        }
     }
-    assert!(order(e[0], e[1]) > 0.8 && order(e[1], e[2]) > 0.8, "observed orders {:.2}, {:.2} (errors {e:?})", order(e[0], e[1]), order(e[1], e[2]));
     // the conforming cylinder: coincident faces give M = D (biorthogonality), a node-to-node tie
     let r = case(json!({"kind": "patch", "lower": "hex8:3", "upper": "hex8:3", "curvature": 1.0, "method": "mortar"}));
     assert!(r.error < CONFORMING_CYL, "conforming cylinder mortar σ {:.3e}", r.error);
