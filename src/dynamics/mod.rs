@@ -108,6 +108,18 @@ fn pair_forces_into(model: &Model, constraints: &mut [&mut dyn Constraint<Contac
     }
 }
 
+/// w = u[n] + c (u[n] − u[n−1]), c = β/dt: the displacement whose K w is the step's elastic
+/// plus stiffness-proportional damping force, K(u[n] + β v_b).
+fn stiffness_damped_displacement_into(w: &mut [f64], state: &State, c: f64) {
+    for_each_entry(w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
+}
+
+/// K u[n] from f = K(u[n] + β v_b) = (1 + c) K u[n] − c K u[n−1] (linearity, c = β/dt): exact
+/// from K u[n−1], a recursion that damps its own round-off by c/(1+c) < 1 per step.
+fn recover_ku_into(ku: &mut [f64], f: &[f64], ku_prev: &[f64], c: f64) {
+    for_each_entry(ku, |i, k| *k = (f[i] + c * ku_prev[i]) / (1.0 + c));
+}
+
 /// The βK terms of one Rayleigh pair's elements when the pairs' β differ
 /// ([`Model::beta_grouped`]): f = K_p (u[n] + β_p v_b), and K_p u[n], K_p u[n−1] recovered from
 /// it as the one-β step does for K (see `ExplicitSolver::internal_forces_of_step`).
@@ -320,12 +332,9 @@ impl ExplicitSolver {
     fn internal_forces_of_step(&mut self, model: &Model, state: &State, beta: f64, constraints: Constraints<'_, '_>) {
         if beta > 0.0 {
             let c = beta / self.dt;
-            for_each_entry(&mut self.w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
+            stiffness_damped_displacement_into(&mut self.w, state, c);
             internal_forces_into(model, constraints, &self.w, &mut self.f_int);
-            // f_int = (1 + c) K u[n] − c K u[n−1] by linearity, so K u[n] follows exactly from
-            // K u[n−1] (a recursion that damps its own round-off by c/(1+c) < 1 per step).
-            let (f_int, ku_prev) = (&self.f_int, &self.ku_prev);
-            for_each_entry(&mut self.ku, |i, k| *k = (f_int[i] + c * ku_prev[i]) / (1.0 + c));
+            recover_ku_into(&mut self.ku, &self.f_int, &self.ku_prev, c);
         } else {
             internal_forces_into(model, constraints, &state.u, &mut self.f_int);
         }
@@ -337,10 +346,9 @@ impl ExplicitSolver {
     fn pair_internal_forces_of_step(&mut self, model: &Model, state: &State, constraints: Constraints<'_, '_>) {
         for p in self.pairs.iter_mut() {
             let c = p.beta / self.dt;
-            for_each_entry(&mut self.w, |i, w| *w = state.u[i] + c * (state.u[i] - state.u_prev[i]));
+            stiffness_damped_displacement_into(&mut self.w, state, c);
             pair_forces_into(model, constraints, p.rock, &self.w, &mut p.f);
-            let (f, ku_prev) = (&p.f, &p.ku_prev);
-            for_each_entry(&mut p.ku, |i, k| *k = (f[i] + c * ku_prev[i]) / (1.0 + c));
+            recover_ku_into(&mut p.ku, &p.f, &p.ku_prev, c);
         }
         let (a, b) = (&self.pairs[0], &self.pairs[1]);
         for_each_entry(&mut self.f_int, |i, f| *f = a.f[i] + b.f[i]);
