@@ -72,13 +72,15 @@ pub fn ssr_problem(mesh: &Mesh, scene: &Scene) -> Result<Problem, Error> {
     Ok(problem)
 }
 
-/// The joints' laws of trial `f`: μ/F and c/F on the scene's laws, cohesion kept.
+/// The joints' laws of trial `f`: μ/F and c/F on the scene's laws, cohesion kept; an asperity
+/// envelope's tan(φ + i)/F too, so that the whole envelope min(tan(φ + i) σ, c + μ σ) is
+/// divided by F (its knee stays at the same σ).
 fn reduced_laws(scene: &Scene, base: &[JointLaw], f: f64) -> Vec<JointLaw> {
     scene
         .joints
         .iter()
         .zip(base)
-        .map(|(j, law)| JointLaw { mu: j.friction().mu() / f, cohesion: j.cohesion.unwrap_or(0.0) / f, keep_cohesion: true, ..*law })
+        .map(|(j, law)| JointLaw { mu: j.friction().mu() / f, cohesion: j.cohesion.unwrap_or(0.0) / f, asperity_friction: j.asperity_friction().map(|s| s / f), keep_cohesion: true, ..*law })
         .collect()
 }
 
