@@ -203,8 +203,9 @@ fn wedge_study_plans_every_level_once_and_the_expensive_runs_first() {
 fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_seed() {
     // A small wedge study on the coarse fixture (3.5 s of El Centro NS + 2/3 vertical), run
     // through its own runs.mk and reported: the headline law is the base scene's (cohesion
-    // kept), the cohesion-loss runs are the labelled variant, the massless rock is compared
-    // with its rigid-rock twin, the seed's quoted values stand beside ours. Physics checked:
+    // kept), the cohesion-loss and the bilinear-envelope (Patton, i = 15°) runs are labelled
+    // variants, each in its own section, the massless rock is compared with its rigid-rock
+    // twin, the seed's quoted values stand beside ours. Physics checked:
     // - at 0.2 g, below the pseudo-static critical acceleration with cohesion (0.354 g,
     //   refs/hoek_bray_wedge.py via rigid::wedge), neither the FEM wedge nor the rigid block
     //   slides (< 1 cm: the seed's "no obvious sliding at 0.5 g and below" holds at 0.2 g);
@@ -233,6 +234,7 @@ fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_
     study["runs"] = json!([
         {"axes": {"pga": "*", "method": ["nts1", "ntn"]}},
         {"axes": {"pga": "pga1.00", "method": "nts1", "law": "closs"}},
+        {"axes": {"pga": "pga1.00", "method": "nts1", "law": "patton"}},
         {"axes": {"pga": "pga1.00", "method": "nts1", "rock": "masslessrock"}},
         {"axes": {"pga": "pga1.00", "method": "nts1", "damping": "undamped"}}
     ]);
@@ -240,16 +242,16 @@ fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_
     std::fs::write(&p, serde_json::to_string_pretty(&study).unwrap()).unwrap();
     let (study, kind) = jointquake::studies::load(&p).unwrap();
     let files = jointquake::study::write_plan(&study, &kind.steps(), &dir.join("cache"), env!("CARGO_BIN_EXE_jointquake")).unwrap();
-    assert_eq!(files.scenes.len(), 7);
+    assert_eq!(files.scenes.len(), 8);
     let o = std::process::Command::new("make").args(["-s", "-j2", "-f"]).arg(&files.makefile).arg("runs").output().expect("make runs");
     assert!(o.status.success(), "make: {}\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     let r = jointquake::study::write_report(&study, kind.as_ref()).unwrap();
     assert!(r.problems.is_empty(), "{:?}", r.problems);
     let md = std::fs::read_to_string(&r.report).unwrap();
-    for s in ["## Seismic runs — headline: cohesion kept", "### The seed's claims", "0.186 / 0.147", "## Variant: cohesion lost after slip (softening to zero over 10 mm)", "## Rock model: massless elastic rock against the rigid rock", "undamped (β = 0)"] {
+    for s in ["## Seismic runs — headline: cohesion kept", "### The seed's claims", "0.186 / 0.147", "## Variant: cohesion lost after slip (softening to zero over 10 mm)", "## Variant: bilinear (Patton) envelope, asperity angle i = 15°, cohesion kept", "## Rock model: massless elastic rock against the rigid rock", "undamped (β = 0)"] {
         assert!(md.contains(s), "report.md lacks {s:?}:\n{md}");
     }
-    for c in ["slip_vs_pga", "slip_vs_pga_variant", "slip_vs_pga_rock", "slip_history", "speed_accuracy"] {
+    for c in ["slip_vs_pga", "slip_vs_pga_variant", "slip_vs_pga_variant2", "slip_vs_pga_rock", "slip_history", "speed_accuracy"] {
         assert!(dir.join(format!("out/charts/{c}.svg")).exists(), "chart {c}");
     }
     let doc: Value = serde_json::from_str(&std::fs::read_to_string(&r.json).unwrap()).unwrap();
