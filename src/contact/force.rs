@@ -631,7 +631,6 @@ fn candidates_into(cand: &mut Vec<u32>, j: &ContactJoint, center: u32, layer: u8
 /// balance at 4e-15 (regression `dam_stays_at_rest_for_two_seconds_with_a_full_reservoir`).
 const PARTIAL_PAIR_UPDATES: usize = 32;
 
-
 /// `Model::fixed` of a node with all three components fixed.
 const ALL_FIXED: u8 = 7;
 
