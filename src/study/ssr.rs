@@ -145,3 +145,34 @@ pub fn strength_reduction(mesh: &Mesh, scene: &Scene, opts: &SsrOptions) -> Resu
         ),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::law::PairHistory;
+
+    #[test]
+    fn strength_reduction_divides_the_whole_bilinear_envelope_by_f() {
+        // Reference: τ_F(σ) = min(tan(φ + i) σ, c + σ tan φ) / F at every σ, so the knee stays at
+        // the same σ (a reduction of tan φ and c alone would move it). φ = 30°, i = 15°,
+        // c = 48 kPa on 1 m², F = 1.5; tolerance round-off (1e-12 relative).
+        let scene: Scene = serde_json::from_value(serde_json::json!({
+            "geometry": {"msh": "unused.msh"},
+            "materials": [{"group": "all", "E": 1e10, "nu": 0.25, "rho": 2500}],
+            "time": {"duration": 1.0},
+            "joints": [{"name": "B", "master": "m", "slave": "s", "phi": 30, "cohesion": 48000, "asperity_angle": 15}]
+        }))
+        .unwrap();
+        scene.validate().unwrap();
+        let j = &scene.joints[0];
+        let base = JointLaw { cohesion: 48e3, asperity_friction: j.asperity_friction(), ..JointLaw::coulomb(j.friction().mu()) };
+        let f = 1.5;
+        let reduced = reduced_laws(&scene, &[base], f)[0];
+        let h = PairHistory::default();
+        for sigma in [0.0, 1e4, 5e4, 1.136e5, 2e5, 1e6] {
+            let (a, b) = (reduced.shear_limit(sigma, &h, 1.0), base.shear_limit(sigma, &h, 1.0) / f);
+            assert!((a - b).abs() <= 1e-12 * b.max(1.0), "σ = {sigma}: {a} vs {b}");
+        }
+        assert!((reduced.knee_force(1.0).unwrap() - base.knee_force(1.0).unwrap()).abs() < 1e-6);
+    }
+}
