@@ -113,10 +113,10 @@ impl JointLaw {
                 return Err(JointLawError { field, value, rule: NON_NEGATIVE });
             }
         }
-        if let Some(s) = self.asperity_friction {
-            if !(s.is_finite() && s > self.mu) {
-                return Err(JointLawError { field: "asperity_friction", value: s, rule: "must be finite and above mu (tan(phi + i) of an asperity angle 0 < i < 90 - phi deg)" });
-            }
+        if let Some(s) = self.asperity_friction
+            && !(s.is_finite() && s > self.mu)
+        {
+            return Err(JointLawError { field: "asperity_friction", value: s, rule: "must be finite and above mu (tan(phi + i) of an asperity angle 0 < i < 90 - phi deg)" });
         }
         Ok(())
     }
