@@ -15,7 +15,9 @@
 //!    a sweep is below `gs_tolerance` (or `gs_max_sweeps`). Once fewer than half the pairs still
 //!    move a node by more than 1 % of the tolerance, a sweep skips the pairs none of whose nodes
 //!    moved since their last evaluation (they would give the same force); before, it takes them
-//!    all without the bookkeeping.
+//!    all without the bookkeeping. With an asperity envelope (`JointLaw::asperity_friction`),
+//!    after the colours of each sweep the pairs of a slave node that has pairs on two such
+//!    joints (the line where two joints meet) are solved together ([`shared_node_pass`]).
 //!
 //! Mobility: w = 1/m_s + Σ N_I²/m_I with 1/m = 0 at a fully fixed node (it does not move under
 //! contact forces). **Partly fixed nodes** (a symmetry plane, a roller: some components fixed)
@@ -412,6 +414,13 @@ pub struct ContactSolver<'m> {
     pub gs_tolerance: f64,
     /// Sweep budget per step. Default 200.
     pub gs_max_sweeps: usize,
+    /// Passes over the pairs of one shared slave node in [`shared_node_pass`], at most, per
+    /// sweep (a count; only with an asperity envelope). Default 50, as measured on the branch
+    /// that first tried it (docs/contact.md, "The bilinear envelope"): the two pairs'
+    /// alternating updates settle within it where their problem has a consistent state, and a
+    /// node whose pairs still trade force after it is left to the next sweep. 0 switches the
+    /// pass off (for measurements).
+    pub gs_shared_passes: usize,
     /// Start each pair that was in contact at the last step from its last force (applied to the
     /// prediction before the first sweep) instead of zero. Default true: the same fixed point,
     /// fewer sweeps (12.2 → 10.8 per step on the contact benchmark).
@@ -480,6 +489,12 @@ pub struct ContactSolver<'m> {
     local: Vec<LocalNode>,
     local_global: Vec<u32>,
     sweep_start: Vec<Vector3<f64>>,
+    /// The shared-node pass ([`shared_node_pass`]): the active pairs (indices into `active`) of
+    /// the slave nodes with pairs on two or more joints with an asperity envelope, grouped by
+    /// node (`shared_runs`: start and end in `shared_pairs`), in the order of the nodes' local
+    /// indices; empty when no joint has an envelope.
+    shared_pairs: Vec<u32>,
+    shared_runs: Vec<(u32, u32)>,
 }
 
 impl<'m> ContactSolver<'m> {
@@ -500,7 +515,7 @@ impl<'m> ContactSolver<'m> {
         }
         let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
-        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_shared_passes: 50, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), shared_pairs: Vec::new(), shared_runs: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Slave faces whose mortar integrals were evaluated so far, all mortar joints together (the
@@ -805,6 +820,49 @@ fn sweep_colors<const LISTED: bool>(active: &mut [Active], order: &[u32], color_
         moving += if parallel && run.len() >= par_min { run.par_chunks(SWEEP_CHUNK.min(par_min.max(1))).map(pass).sum::<usize>() } else { pass(run) };
     }
     moving
+}
+
+/// The groups of the shared-node pass: pairs (indices into the active pairs), their runs by
+/// slave node, the squared change [m²] below which a node's pairs count as solved together, and
+/// the most passes per node (`ContactSolver::gs_shared_passes`).
+struct SharedGroups<'a> {
+    pairs: &'a [u32],
+    runs: &'a [(u32, u32)],
+    tol2: f64,
+    passes: usize,
+}
+
+/// The shared-node pass (after each sweep's colours, only with an asperity envelope): the pairs
+/// of each slave node that has pairs on two joints (`shared.runs`) updated in turn, again and
+/// again, until a pass over them changes none of their nodes by more than the tolerance, at most
+/// `shared.passes` times. Such a node is constrained by two pairs against two master
+/// planes; one pair's update undoes part of the other's, and in a sweep they meet once: solved
+/// together, the node's two-pair problem is settled before the rest of the joint sees it. With
+/// `LISTED` the updates stamp the nodes they move (one tick per pair), so that the work list
+/// takes the pairs on them in the next sweep. One thread, in the groups' order: deterministic,
+/// and the same on any number of threads.
+#[allow(clippy::too_many_arguments)]
+fn shared_node_pass<const LISTED: bool>(active: &mut [Active], shared: &SharedGroups<'_>, local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]]) {
+    let mut before: Vec<(u32, Vector3<f64>)> = Vec::new();
+    for &(start, end) in shared.runs {
+        let group = &shared.pairs[start as usize..end as usize];
+        before.clear();
+        for &k in group {
+            let a = &active[k as usize];
+            before.extend(a.local[..a.span()].iter().map(|&l| (l, Vector3::zeros())));
+        }
+        for _ in 0..shared.passes {
+            for (l, x) in before.iter_mut() {
+                *x = local[*l as usize].x;
+            }
+            let (pa, pl, pe) = (Shared::of(active), Shared::of(local), Shared::of(evaluated_at));
+            // SAFETY: one thread
+            unsafe { sweep_pass::<LISTED, 5>(pa, group, pl, pe, clock, true, laws, mark_tol2, mob_matrix) };
+            if before.iter().all(|(l, x)| (local[*l as usize].x - x).norm_squared() <= shared.tol2) {
+                break;
+            }
+        }
+    }
 }
 
 /// One Gauss–Seidel pass over the active pairs in `order` (see [`ContactSolver::sweep_into`]):
@@ -1539,11 +1597,31 @@ impl ContactSolver<'_> {
         // mortar pairs: in the order of the search, after the node-to-segment pairs
         self.mortar.order.clear();
         self.mortar.order.extend(0..self.mortar.active.len() as u32);
+        self.group_shared_nodes();
         self.sweep_start.resize(self.local.len(), Vector3::zeros());
         self.evaluated_at.clear();
         self.evaluated_at.resize(self.active.len(), 0);
         self.mortar.evaluated_at.clear();
         self.mortar.evaluated_at.resize(self.mortar.active.len(), 0);
+    }
+
+    /// The groups of the shared-node pass (`shared_pairs`, `shared_runs`): the active pairs of
+    /// joints with an asperity envelope, by slave node, where a node has two or more. Nothing
+    /// (and no cost beyond a test per joint) when no joint has an envelope. Deterministic: the
+    /// nodes in the order of their local indices, each node's pairs in the order of `active`.
+    fn group_shared_nodes(&mut self) {
+        self.shared_pairs.clear();
+        self.shared_runs.clear();
+        if self.joints.iter().all(|j| j.law.asperity_friction.is_none()) {
+            return;
+        }
+        let mut by_node: Vec<(u32, u32)> = self.active.iter().enumerate().filter(|(_, a)| self.joints[a.joint as usize].law.asperity_friction.is_some()).map(|(k, a)| (a.local[0], k as u32)).collect();
+        by_node.sort_unstable();
+        for run in by_node.chunk_by(|x, y| x.0 == y.0).filter(|r| r.len() >= 2) {
+            let start = self.shared_pairs.len() as u32;
+            self.shared_pairs.extend(run.iter().map(|&(_, k)| k));
+            self.shared_runs.push((start, self.shared_pairs.len() as u32));
+        }
     }
 
     /// The Gauss–Seidel sweeps over the active pairs; returns the sweeps made and whether they
@@ -1557,7 +1635,7 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, color_runs, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, mob_matrix, mortar, sweep_par_min, .. } = self;
+        let ContactSolver { active, order, color_runs, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, .. } = self;
         let parallel = rayon::current_num_threads() > 1;
         let mut sweeps = 0;
         let pairs = active.len() + mortar.active.len();
@@ -1595,6 +1673,14 @@ impl ContactSolver<'_> {
             } else {
                 sweep_colors::<false>(active, order, color_runs, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix, parallel, *sweep_par_min)
             };
+            if !shared_runs.is_empty() {
+                let shared = SharedGroups { pairs: shared_pairs, runs: shared_runs, tol2: *gs_tolerance * *gs_tolerance, passes: *gs_shared_passes };
+                if listed {
+                    shared_node_pass::<true>(active, &shared, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix);
+                } else {
+                    shared_node_pass::<false>(active, &shared, local, evaluated_at, &mut clock, &laws, mark_tol2, mob_matrix);
+                }
+            }
             if !m.active.is_empty() {
                 let (pa, pl, pe) = (Shared::of(&mut m.active), Shared::of(local), Shared::of(&mut m.evaluated_at));
                 // SAFETY: one thread

@@ -54,7 +54,8 @@ pub struct ContactJoint {
 }
 
 impl ContactJoint {
-    /// Tag a scene joint on the mesh (whose blocks are `blocks`) and resolve its law and options.
+    /// Tag a scene joint on the mesh (whose blocks are `blocks`) and resolve its law and options
+    /// (an `asperity_angle` i becomes the law's `asperity_friction` tan(φ + i)).
     pub fn build(mesh: &Mesh, blocks: &Blocks, spec: &JointSceneSpec, model_size: f64) -> Result<ContactJoint, Error> {
         let bad = |m: String| -> Error { ModelError::Invalid(format!("joint \"{}\": {m}", spec.name)).into() };
         let mu = spec.friction().mu();
@@ -66,6 +67,7 @@ impl ContactJoint {
             tied: spec.tied.unwrap_or(false),
             open_tolerance: 0.0,
             softening_slip: spec.softening_slip.unwrap_or(0.0),
+            asperity_friction: spec.asperity_friction(),
         };
         law.validate().map_err(|e| bad(e.to_string()))?;
         let method = match spec.method() {

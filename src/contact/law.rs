@@ -19,8 +19,9 @@
 //!    and `g̃ ≥ 0`: **open**, `R = 0`.
 //! 3. Otherwise `r_n = −g̃/k`. Tension (`r_n < 0`, bonded pairs only) beyond `σ_t A`: the bond
 //!    breaks and the pair opens, `R = 0`.
-//! 4. Trial `r_t = −Δd̃_t/k`, limit `τ = μ r_n + c A` (`c A` only while intact), clamped at 0.
-//!    `|r_t| ≤ τ`: **stick** (state `Bonded` for a bonded pair). Else **slip**: `r_t` scaled back
+//! 4. Trial `r_t = −Δd̃_t/k`, limit `τ = μ r_n + c A` (`c A` only while intact), clamped at 0
+//!    (with an asperity angle, the bilinear envelope `min(tan(φ + i) r_n, μ r_n + c A)`:
+//!    [`JointLaw::shear_limit`]). `|r_t| ≤ τ`: **stick** (state `Bonded` for a bonded pair). Else **slip**: `r_t` scaled back
 //!    to `τ` along the trial direction (opposite to the trial slip).
 //!
 //! The bond (cohesion and tensile strength) is lost on the first slip or opening (`g̃ > 0` while
@@ -72,6 +73,18 @@ pub struct JointLaw {
     /// elastic creep of its edges, where the loading path concentrates shear.
     #[serde(default)]
     pub softening_slip: f64,
+    /// The bilinear (Patton 1966) envelope's first branch, tan(φ + i) [-]: the friction of a
+    /// joint riding up its first-order asperities of angle i (the scene's
+    /// `joints[].asperity_angle` [deg], converted in `contact::joint`). With it the shear limit
+    /// is min(tan(φ + i) r_n, μ r_n + c A) for r_n ≥ 0 ([`JointLaw::shear_limit`]): through the
+    /// origin below the knee σ_k = c / (tan(φ + i) − μ), the cohesive Coulomb line above it.
+    /// Default `None`: the seed's truncated Mohr–Coulomb cone μ r_n + c A. Must be finite and
+    /// above μ ([`JointLaw::validate`]). A pair in tension (a bond with tensile strength) would
+    /// carry no shear under it: the scene refuses an asperity angle with a tensile strength,
+    /// without cohesion (the envelope is then the Coulomb line) or on a tied joint
+    /// (`scene::validate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub asperity_friction: Option<f64>,
 }
 
 /// Round-off scale of a gap, relative to the largest coordinate magnitude of the joint (plus
@@ -82,7 +95,7 @@ pub const OPEN_TOLERANCE_RELATIVE: f64 = 1e-12;
 impl JointLaw {
     /// Pure Coulomb friction μ: no cohesion, no tension, brittle defaults.
     pub fn coulomb(mu: f64) -> Self {
-        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false, open_tolerance: 0.0, softening_slip: 0.0 }
+        JointLaw { mu, cohesion: 0.0, tensile_strength: 0.0, keep_cohesion: false, tied: false, open_tolerance: 0.0, softening_slip: 0.0, asperity_friction: None }
     }
 
     /// A glued (tied) interface.
@@ -90,38 +103,70 @@ impl JointLaw {
         JointLaw { tied: true, ..JointLaw::coulomb(0.0) }
     }
 
-    /// Check that every parameter is finite and non-negative; the error names the field.
+    /// Check that every parameter is finite and non-negative, and that an asperity envelope
+    /// has what it needs ([`JointLaw::asperity_friction`]); the error names the field.
     pub fn validate(&self) -> Result<(), JointLawError> {
         for (field, value) in
             [("mu", self.mu), ("cohesion", self.cohesion), ("tensile_strength", self.tensile_strength), ("open_tolerance", self.open_tolerance), ("softening_slip", self.softening_slip)]
         {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(JointLawError { field, value });
+                return Err(JointLawError { field, value, rule: NON_NEGATIVE });
             }
+        }
+        if let Some(s) = self.asperity_friction
+            && !(s.is_finite() && s > self.mu)
+        {
+            return Err(JointLawError { field: "asperity_friction", value: s, rule: "must be finite and above mu (tan(phi + i) of an asperity angle 0 < i < 90 - phi deg)" });
         }
         Ok(())
     }
 }
 
-/// An invalid joint-law parameter.
+/// The rule of [`JointLawError`] for the numbers that must be finite and non-negative.
+const NON_NEGATIVE: &str = "must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa, open_tolerance and softening_slip in m)";
+
+/// An invalid joint-law parameter: the field, its value and the rule it breaks.
 #[derive(Clone, Debug, PartialEq, Error)]
-#[error(
-    "joint law: `{field}` = {value} must be a finite number >= 0 (mu dimensionless, cohesion and tensile_strength in Pa, open_tolerance and softening_slip in m)"
-)]
+#[error("joint law: `{field}` = {value} {rule}")]
 pub struct JointLawError {
     pub field: &'static str,
     pub value: f64,
+    pub rule: &'static str,
 }
 
 impl JointLaw {
-    /// The Mohr-Coulomb limit of the tangential force (N) under normal force `r_n` (N,
-    /// compressive): μ r_n + the cohesive force, not below 0. The floor by comparison:
-    /// `f64::max`'s NaN handling cost a thirtieth of a Gauss–Seidel sweep; a NaN limit gives 0
-    /// either way. One definition for the dynamic contact force and the penalty springs.
+    /// The limit of the tangential force (N) under normal force `r_n` (N, compressive): the
+    /// Mohr-Coulomb line μ r_n + the cohesive force, with an asperity envelope
+    /// ([`JointLaw::asperity_friction`] s) the smaller of it and s r_n; not below 0. The floor
+    /// by comparison: `f64::max`'s NaN handling cost a thirtieth of a Gauss–Seidel sweep; a NaN
+    /// limit gives 0 either way. One definition for the dynamic contact force, the penalty
+    /// springs, the static contact and the outputs.
     #[inline(always)]
     pub fn shear_limit(&self, r_n: f64, hist: &PairHistory, area: f64) -> f64 {
-        let limit = self.mu * r_n + self.cohesion_force(hist, area);
-        if limit > 0.0 { limit } else { 0.0 }
+        self.shear_limit_with_slope(r_n, hist, area).0
+    }
+
+    /// [`JointLaw::shear_limit`] and its derivative with respect to `r_n` (dimensionless): μ
+    /// on the Coulomb line, s on the asperity branch, 0 at the floor (the static contact's
+    /// tangent).
+    #[inline(always)]
+    pub fn shear_limit_with_slope(&self, r_n: f64, hist: &PairHistory, area: f64) -> (f64, f64) {
+        let mut limit = self.mu * r_n + self.cohesion_force(hist, area);
+        let mut slope = self.mu;
+        if let Some(s) = self.asperity_friction {
+            let asperity = s * r_n;
+            if asperity < limit {
+                limit = asperity;
+                slope = s;
+            }
+        }
+        if limit > 0.0 { (limit, slope) } else { (0.0, 0.0) }
+    }
+
+    /// The normal force of the envelope's knee (N) for a pair of area `area` [m²] with its
+    /// bond intact, c A / (s − μ); `None` without an asperity envelope.
+    pub fn knee_force(&self, area: f64) -> Option<f64> {
+        self.asperity_friction.map(|s| self.cohesion * area / (s - self.mu))
     }
 
     /// The cohesive force of a pair (N): c A while intact, softened linearly with the
@@ -368,7 +413,7 @@ mod tests {
     const AREA: f64 = 0.25;
 
     fn law(mu: f64, c: f64, st: f64) -> JointLaw {
-        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false, open_tolerance: 0.0, softening_slip: 0.0 }
+        JointLaw { mu, cohesion: c, tensile_strength: st, keep_cohesion: false, tied: false, open_tolerance: 0.0, softening_slip: 0.0, asperity_friction: None }
     }
 
     #[test]
@@ -523,6 +568,57 @@ mod tests {
         assert_eq!(l, JointLaw::coulomb(0.6));
         assert!(serde_json::from_str::<JointLaw>(r#"{"mu": 0.6, "cohesoin": 1}"#).is_err());
         assert_eq!(serde_json::to_string(&PairState::Slip).unwrap(), "\"slip\"");
+    }
+
+    #[test]
+    fn asperity_envelope_is_bilinear_through_the_origin() {
+        // Reference (Patton 1966): τ = min(tan(φ + i) σ, c + σ tan φ) for σ ≥ 0. φ = 30°, i = 15°,
+        // c = 48 kPa on A = 0.25 m²: tan 45° = 1, μ = 0.57735, the knee at
+        // σ_k A = c A / (1 − μ) = 12 000 / 0.42265 = 28 392 N. Tolerance: round-off (1e-12
+        // relative).
+        let mu = 30f64.to_radians().tan();
+        let s = 45f64.to_radians().tan();
+        let l = JointLaw { asperity_friction: Some(s), keep_cohesion: true, ..law(mu, 48e3, 0.0) };
+        assert!(l.validate().is_ok());
+        let ca = 48e3 * AREA;
+        let knee = l.knee_force(AREA).unwrap();
+        assert!((knee - ca / (1.0 - mu)).abs() < 1e-9 * knee && (knee - 28_392.0).abs() < 1.0, "knee {knee}");
+        let h = PairHistory::default();
+        for (r_n, expected) in [(0.0, 0.0), (1e3, s * 1e3), (0.5 * knee, s * 0.5 * knee), (2.0 * knee, mu * 2.0 * knee + ca), (1e6, mu * 1e6 + ca)] {
+            let (lim, slope) = l.shear_limit_with_slope(r_n, &h, AREA);
+            assert!((lim - expected).abs() <= 1e-12 * expected.max(1.0), "r_n {r_n}: {lim} vs {expected}");
+            assert_eq!(lim, l.shear_limit(r_n, &h, AREA));
+            let branch = if r_n == 0.0 { 0.0 } else if r_n < knee { s } else { mu };
+            assert_eq!(slope, branch, "r_n {r_n}");
+        }
+        // continuous at the knee, and below the seed's cone everywhere (equal above the knee)
+        let at = |r: f64| l.shear_limit(r, &h, AREA);
+        assert!((at(knee * (1.0 - 1e-9)) - at(knee * (1.0 + 1e-9))).abs() < 1e-6 * ca);
+        let cone = JointLaw { asperity_friction: None, ..l };
+        assert!((0..50).map(|k| k as f64 * 1e3).all(|r| at(r) <= cone.shear_limit(r, &h, AREA)));
+        // the dynamic force slips at that limit: a closed pair at small r_n carries no more than
+        // s r_n (the cone's c A there is what made the force jump at g = 0)
+        let g = -1e3 * DT2W; // r_n = 1e3 N
+        let r = pair_force(&l, &h, g, Vector2::new(1.0, 0.0), DT2W, AREA);
+        assert_eq!(r.state, PairState::Slip);
+        assert!((r.r_t.norm() - s * 1e3).abs() < 1e-12 * s * 1e3, "{}", r.r_t.norm());
+        assert!(pair_force(&cone, &h, g, Vector2::new(1.0, 0.0), DT2W, AREA).r_t.norm() > ca);
+        // once the bond is lost (brittle law) the Coulomb line through the origin is below s r_n
+        let lost = PairHistory { intact: false, slip: 1.0 };
+        assert_eq!(l.shear_limit(1e3, &lost, AREA), mu * 1e3);
+    }
+
+    #[test]
+    fn asperity_envelope_validation_names_the_field() {
+        let ok = JointLaw { asperity_friction: Some(1.0), ..law(0.6, 1e4, 0.0) };
+        assert!(ok.validate().is_ok());
+        for bad in [0.5, 0.6, f64::INFINITY, f64::NAN] {
+            let e = JointLaw { asperity_friction: Some(bad), ..ok }.validate().unwrap_err();
+            assert_eq!(e.field, "asperity_friction");
+            assert!(e.to_string().contains("above mu") && e.to_string().contains("`asperity_friction`"), "{e}");
+        }
+        // the default law has none, and its serialisation does not name it
+        assert!(!serde_json::to_string(&law(0.6, 1e4, 0.0)).unwrap().contains("asperity"));
     }
 
     #[test]

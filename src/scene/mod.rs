@@ -740,6 +740,17 @@ pub struct JointSceneSpec {
     /// opening beyond it breaks the bond). Default 0: brittle, lost at the first slip or opening.
     #[serde(default)]
     pub softening_slip: Option<f64>,
+    /// Asperity angle i [deg] of the bilinear (Patton 1966) shear envelope
+    /// τ ≤ min(tan(φ + i) σ, c + σ tan φ): below the knee σ_k = c / (tan(φ + i) − tan φ) the
+    /// joint shears by riding up its first-order asperities (through the origin: no shear
+    /// without compression), above it along the cohesive Coulomb line. A measured property of
+    /// the joint's roughness (Patton 1966; Barton & Choubey 1977: first-order i of rock joints
+    /// typically 5–20°), stated by the scene, never chosen for the solver's convergence.
+    /// Default none: the seed's truncated Mohr–Coulomb cone (c + σ tan φ for σ ≥ 0). Needs
+    /// 0 < i < 90° − φ, cohesion > 0, no tensile strength, not tied (docs/contact.md, "The
+    /// bilinear envelope").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub asperity_angle: Option<f64>,
     /// Tied (bonded, never opens or slides). Default false.
     #[serde(default)]
     pub tied: Option<bool>,
@@ -845,6 +856,12 @@ impl JointSceneSpec {
             (None, Some(p)) => Friction::Phi(p),
             (None, None) => Friction::Mu(DEFAULT_FRICTION),
         }
+    }
+
+    /// The friction of the asperity envelope's first branch, tan(φ + i) [-] (`asperity_angle`
+    /// i), or `None` (the Mohr–Coulomb cone); call on a validated scene.
+    pub fn asperity_friction(&self) -> Option<f64> {
+        self.asperity_angle.map(|i| (self.friction().phi_deg() + i).to_radians().tan())
     }
 
     /// The joint's contact method (default node-to-segment).

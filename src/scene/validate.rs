@@ -333,6 +333,30 @@ fn validate_joint_numbers(j: &JointSceneSpec) -> Result<(), String> {
             return Err(format!("{} = {t} must be positive [m]", f("tolerance")));
         }
     }
+    validate_asperity_angle(j)
+}
+
+/// A joint's `asperity_angle` (the bilinear envelope, `JointSceneSpec::asperity_angle`): i in
+/// (0, 90° − φ) so that tan(φ + i) is finite and above tan φ, on a joint with cohesion (else the
+/// knee is at σ = 0 and the envelope is the Coulomb line), without tensile strength (the
+/// envelope carries no shear without compression, which a bond in tension contradicts), not
+/// tied (a tie has no shear limit).
+fn validate_asperity_angle(j: &JointSceneSpec) -> Result<(), String> {
+    let Some(i) = j.asperity_angle else { return Ok(()) };
+    let field = format!("joint \"{}\": asperity_angle", j.name);
+    let phi = j.friction().phi_deg();
+    if !(i.is_finite() && i > 0.0 && i < 90.0 - phi) {
+        return Err(format!("{field} = {i} deg must be in (0, 90 - phi) = (0, {:.3}) deg for this joint's phi = {phi:.3} deg (tan(phi + i) must be finite and above tan phi): give the joint's measured first-order asperity angle (typically 5-20 deg), or remove it for the Mohr-Coulomb cone", 90.0 - phi));
+    }
+    if j.cohesion.unwrap_or(0.0) <= 0.0 {
+        return Err(format!("{field} needs `cohesion` > 0 (with c = 0 the envelope's knee is at 0 and it is the Coulomb line): give the joint's cohesion [Pa], or remove asperity_angle"));
+    }
+    if j.tensile_strength.unwrap_or(0.0) > 0.0 {
+        return Err(format!("{field} and `tensile_strength` exclude each other (the envelope carries no shear without compression; a bond in tension contradicts it): remove one of them"));
+    }
+    if j.tied == Some(true) {
+        return Err(format!("{field} on a tied joint has no effect (a tie has no shear limit): remove one of them"));
+    }
     Ok(())
 }
 

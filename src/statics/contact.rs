@@ -26,7 +26,8 @@
 //! masters). Forces in N, displacements in m.
 //! - **open** (r_n < −σ_t A: tension beyond the tensile strength, 0 for the dam): q = 0;
 //! - **stick** (k |w_t| ≤ L, L = `JointLaw::shear_limit`(r_n)): q = k w, tangent k I;
-//! - **slip**: q = k g n + L w_t/|w_t|, tangent k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) − μ k t̂ nᵀ,
+//! - **slip**: q = k g n + L w_t/|w_t|, tangent k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) − L' k t̂ nᵀ
+//!   (L' = ∂L/∂r_n: μ, or tan(φ + i) below an asperity envelope's knee),
 //!   t̂ = w_t/|w_t|. The last term (the limit grows with the normal force) makes K_T
 //!   unsymmetric (hence GMRES, not CG); without it Newton diverged on the coarse dam
 //!   (it is of the penalty's size).
@@ -178,7 +179,8 @@ fn relative_motion(p: &Pair, uh: &[f64]) -> Vector3<f64> {
 
 /// A pair's tangent ∂q/∂w split as `spd + coupling`: `spd` symmetric positive semi-definite
 /// (k I stick; k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) slip; 0 open), `coupling` the friction
-/// limit's growth with the normal force (−μ k t̂ nᵀ while slipping, else 0), and the state.
+/// limit's growth with the normal force (−L' k t̂ nᵀ while slipping, L' = ∂L/∂r_n, else 0), and
+/// the state.
 #[derive(Clone, Copy, Debug)]
 struct PairTangent {
     state: PairState,
@@ -195,15 +197,16 @@ fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, h
         return (PairState::Open, Vector3::zeros(), PairTangent { state: PairState::Open, spd: Matrix3::zeros(), coupling: Matrix3::zeros() });
     }
     let wt = w - p.n * g;
-    let limit = law.shear_limit(r_n, &history, p.area);
+    let (limit, slope) = law.shear_limit_with_slope(r_n, &history, p.area);
     let nn = p.n * p.n.transpose();
     if p.k * wt.norm() <= limit {
         (PairState::Stick, w * p.k, PairTangent { state: PairState::Stick, spd: Matrix3::identity() * p.k, coupling: Matrix3::zeros() })
     } else {
         let t = wt / wt.norm();
         let ks = limit / wt.norm();
-        // ∂L/∂w = −μ k nᵀ while the limit is above its floor 0
-        let coupling = if limit > 0.0 { t * p.n.transpose() * (-law.mu * p.k) } else { Matrix3::zeros() };
+        // ∂L/∂w = −(∂L/∂r_n) k nᵀ while the limit is above its floor 0: μ on the Coulomb line,
+        // tan(φ + i) on an asperity envelope's first branch, 0 at the floor
+        let coupling = if limit > 0.0 { t * p.n.transpose() * (-slope * p.k) } else { Matrix3::zeros() };
         let spd = nn * p.k + (Matrix3::identity() - nn - t * t.transpose()) * ks;
         (PairState::Slip, p.n * (p.k * g) + t * limit, PairTangent { state: PairState::Slip, spd, coupling })
     }

@@ -72,13 +72,15 @@ pub fn ssr_problem(mesh: &Mesh, scene: &Scene) -> Result<Problem, Error> {
     Ok(problem)
 }
 
-/// The joints' laws of trial `f`: μ/F and c/F on the scene's laws, cohesion kept.
+/// The joints' laws of trial `f`: μ/F and c/F on the scene's laws, cohesion kept; an asperity
+/// envelope's tan(φ + i)/F too, so that the whole envelope min(tan(φ + i) σ, c + μ σ) is
+/// divided by F (its knee stays at the same σ).
 fn reduced_laws(scene: &Scene, base: &[JointLaw], f: f64) -> Vec<JointLaw> {
     scene
         .joints
         .iter()
         .zip(base)
-        .map(|(j, law)| JointLaw { mu: j.friction().mu() / f, cohesion: j.cohesion.unwrap_or(0.0) / f, keep_cohesion: true, ..*law })
+        .map(|(j, law)| JointLaw { mu: j.friction().mu() / f, cohesion: j.cohesion.unwrap_or(0.0) / f, asperity_friction: j.asperity_friction().map(|s| s / f), keep_cohesion: true, ..*law })
         .collect()
 }
 
@@ -142,4 +144,35 @@ pub fn strength_reduction(mesh: &Mesh, scene: &Scene, opts: &SsrOptions) -> Resu
             opts.residual, opts.max_steps, opts.slip_limit
         ),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::law::PairHistory;
+
+    #[test]
+    fn strength_reduction_divides_the_whole_bilinear_envelope_by_f() {
+        // Reference: τ_F(σ) = min(tan(φ + i) σ, c + σ tan φ) / F at every σ, so the knee stays at
+        // the same σ (a reduction of tan φ and c alone would move it). φ = 30°, i = 15°,
+        // c = 48 kPa on 1 m², F = 1.5; tolerance round-off (1e-12 relative).
+        let scene: Scene = serde_json::from_value(serde_json::json!({
+            "geometry": {"msh": "unused.msh"},
+            "materials": [{"group": "all", "E": 1e10, "nu": 0.25, "rho": 2500}],
+            "time": {"duration": 1.0},
+            "joints": [{"name": "B", "master": "m", "slave": "s", "phi": 30, "cohesion": 48000, "asperity_angle": 15}]
+        }))
+        .unwrap();
+        scene.validate().unwrap();
+        let j = &scene.joints[0];
+        let base = JointLaw { cohesion: 48e3, asperity_friction: j.asperity_friction(), ..JointLaw::coulomb(j.friction().mu()) };
+        let f = 1.5;
+        let reduced = reduced_laws(&scene, &[base], f)[0];
+        let h = PairHistory::default();
+        for sigma in [0.0, 1e4, 5e4, 1.136e5, 2e5, 1e6] {
+            let (a, b) = (reduced.shear_limit(sigma, &h, 1.0), base.shear_limit(sigma, &h, 1.0) / f);
+            assert!((a - b).abs() <= 1e-12 * b.max(1.0), "σ = {sigma}: {a} vs {b}");
+        }
+        assert!((reduced.knee_force(1.0).unwrap() - base.knee_force(1.0).unwrap()).abs() < 1e-6);
+    }
 }

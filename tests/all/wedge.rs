@@ -169,18 +169,19 @@ fn wedge_study_plans_every_level_once_and_the_expensive_runs_first() {
     // The committed study file (issue 17): the headline (cohesion kept, rigid rock, β of the
     // base scene) NTS-L1 and NTN on the medium mesh at 5 PGAs, NTS-L2 on medium and fine at
     // 1.0 g, NTS-L1 and NTN on the coarse mesh at 5 PGAs on the rigid and on the massless rock,
-    // undamped NTS-L1 and NTN at 1.0 g, the cohesion-loss variant (NTS-L1, NTN, medium, 0.5,
-    // 1.0, 1.5 g), E × 0.5 and × 2 at 1.0 g, dual mortar on the medium mesh at 1.0 g (issue
-    // 31): 43 runs, no duplicates, the fine run first, one run with frames (the medium NTS-L1
-    // headline run at 1.0 g, to look at in ParaView).
+    // undamped NTS-L1 and NTN at 1.0 g, the cohesion-loss variant and the bilinear (Patton,
+    // i = 15°) variant (each NTS-L1, NTN, medium, 0.5, 1.0, 1.5 g), E × 0.5 and × 2 at 1.0 g,
+    // dual mortar on the medium mesh at 1.0 g (issue 31): 49 runs, no duplicates, the fine run
+    // first, one run with frames (the medium NTS-L1 headline run at 1.0 g, to look at in
+    // ParaView).
     let (study, kind) = jointquake::studies::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge_study.json"))).unwrap();
     let runs = plan_runs(&study).unwrap();
     let mut ids: Vec<&str> = runs.iter().map(|r| r.id.as_str()).collect();
-    assert_eq!(runs.len(), 10 + 2 + 1 + 10 + 10 + 2 + 6 + 2, "{ids:?}");
+    assert_eq!(runs.len(), 10 + 2 + 1 + 10 + 10 + 2 + 6 + 6 + 2, "{ids:?}");
     assert_eq!(runs[0].label("mesh"), Some("fine"), "{ids:?}");
     let frames: Vec<&str> = runs.iter().filter(|r| r.overrides.iter().any(|o| o.scene.get("/output/frames") == Some(&json!(true)))).map(|r| r.id.as_str()).collect();
     assert_eq!(frames, ["nts1-medium-pga1.00-ckept-rigidrock"]);
-    for id in ["nts1-medium-pga1.00-ckept-E0.5-rigidrock", "ntn-coarse-pga0.20-ckept-masslessrock", "ntn-medium-pga1.50-closs-rigidrock", "nts1-medium-pga1.00-ckept-undamped-rigidrock", "nts2-medium-pga1.00-ckept-rigidrock", "mortar-medium-pga1.00-ckept-rigidrock"] {
+    for id in ["nts1-medium-pga1.00-ckept-E0.5-rigidrock", "ntn-coarse-pga0.20-ckept-masslessrock", "ntn-medium-pga1.50-closs-rigidrock", "nts1-medium-pga1.00-ckept-undamped-rigidrock", "nts2-medium-pga1.00-ckept-rigidrock", "mortar-medium-pga1.00-ckept-rigidrock", "ntn-medium-pga0.50-patton-rigidrock"] {
         assert!(ids.contains(&id), "{id} not in {ids:?}");
     }
     ids.sort();
@@ -202,8 +203,9 @@ fn wedge_study_plans_every_level_once_and_the_expensive_runs_first() {
 fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_seed() {
     // A small wedge study on the coarse fixture (3.5 s of El Centro NS + 2/3 vertical), run
     // through its own runs.mk and reported: the headline law is the base scene's (cohesion
-    // kept), the cohesion-loss runs are the labelled variant, the massless rock is compared
-    // with its rigid-rock twin, the seed's quoted values stand beside ours. Physics checked:
+    // kept), the cohesion-loss and the bilinear-envelope (Patton, i = 15°) runs are labelled
+    // variants, each in its own section, the massless rock is compared with its rigid-rock
+    // twin, the seed's quoted values stand beside ours. Physics checked:
     // - at 0.2 g, below the pseudo-static critical acceleration with cohesion (0.354 g,
     //   refs/hoek_bray_wedge.py via rigid::wedge), neither the FEM wedge nor the rigid block
     //   slides (< 1 cm: the seed's "no obvious sliding at 0.5 g and below" holds at 0.2 g);
@@ -232,6 +234,7 @@ fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_
     study["runs"] = json!([
         {"axes": {"pga": "*", "method": ["nts1", "ntn"]}},
         {"axes": {"pga": "pga1.00", "method": "nts1", "law": "closs"}},
+        {"axes": {"pga": "pga1.00", "method": "nts1", "law": "patton"}},
         {"axes": {"pga": "pga1.00", "method": "nts1", "rock": "masslessrock"}},
         {"axes": {"pga": "pga1.00", "method": "nts1", "damping": "undamped"}}
     ]);
@@ -239,16 +242,16 @@ fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_
     std::fs::write(&p, serde_json::to_string_pretty(&study).unwrap()).unwrap();
     let (study, kind) = jointquake::studies::load(&p).unwrap();
     let files = jointquake::study::write_plan(&study, &kind.steps(), &dir.join("cache"), env!("CARGO_BIN_EXE_jointquake")).unwrap();
-    assert_eq!(files.scenes.len(), 7);
+    assert_eq!(files.scenes.len(), 8);
     let o = std::process::Command::new("make").args(["-s", "-j2", "-f"]).arg(&files.makefile).arg("runs").output().expect("make runs");
     assert!(o.status.success(), "make: {}\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     let r = jointquake::study::write_report(&study, kind.as_ref()).unwrap();
     assert!(r.problems.is_empty(), "{:?}", r.problems);
     let md = std::fs::read_to_string(&r.report).unwrap();
-    for s in ["## Seismic runs — headline: cohesion kept", "### The seed's claims", "0.186 / 0.147", "## Variant: cohesion lost after slip (softening to zero over 10 mm)", "## Rock model: massless elastic rock against the rigid rock", "undamped (β = 0)"] {
+    for s in ["## Seismic runs — headline: cohesion kept", "### The seed's claims", "0.186 / 0.147", "## Variant: cohesion lost after slip (softening to zero over 10 mm)", "## Variant: bilinear (Patton) envelope, asperity angle i = 15°, cohesion kept", "## Rock model: massless elastic rock against the rigid rock", "undamped (β = 0)"] {
         assert!(md.contains(s), "report.md lacks {s:?}:\n{md}");
     }
-    for c in ["slip_vs_pga", "slip_vs_pga_variant", "slip_vs_pga_rock", "slip_history", "speed_accuracy"] {
+    for c in ["slip_vs_pga", "slip_vs_pga_variant", "slip_vs_pga_variant2", "slip_vs_pga_rock", "slip_history", "speed_accuracy"] {
         assert!(dir.join(format!("out/charts/{c}.svg")).exists(), "chart {c}");
     }
     let doc: Value = serde_json::from_str(&std::fs::read_to_string(&r.json).unwrap()).unwrap();
@@ -272,4 +275,107 @@ fn wedge_study_reports_the_headline_the_variant_and_the_rock_models_against_the_
     let umax = rh.u.iter().map(|u| (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()).fold(0.0, f64::max);
     eprintln!("massless rock: R moves at most {umax:.3e} m relative to the base");
     assert!(umax > 0.0 && umax < 0.01, "massless rock: R moves {umax} m");
+}
+
+/// The scene of pipelines/wedge.json on the coarse fixture (hw 8, hr 30: 34 and 33 slave
+/// nodes), its El Centro NS + 2/3 vertical at 1.0 g for `duration` s, with the asperity angles
+/// `angles` [deg] of joints A and B (`None`: the seed's Mohr–Coulomb cone).
+fn coarse_wedge_demo(angles: [Option<f64>; 2], duration: f64) -> jointquake::scene::Scene {
+    let mut v: Value = serde_json::from_str(&std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/wedge.json")).unwrap()).unwrap();
+    v["geometry"] = json!({"msh": fixture("wedge_coarse.msh")});
+    for b in v["loads"]["base"].as_array_mut().unwrap() {
+        b["record"] = json!(concat!(env!("CARGO_MANIFEST_DIR"), "/pipelines/records/elcentro1940_NS_chopra.txt"));
+    }
+    v["time"]["duration"] = json!(duration);
+    v["output"] = json!({"frames": false});
+    for (j, a) in v["joints"].as_array_mut().unwrap().iter_mut().zip(angles) {
+        if let Some(a) = a {
+            j["asperity_angle"] = json!(a);
+        }
+    }
+    let sc = scene(v);
+    sc.validate().unwrap();
+    sc
+}
+
+/// The coarse wedge demo run through its static state and `duration` s of the record on
+/// `threads` threads, with the shared-node pass's budget `shared_passes` (and colours of 4
+/// pairs or more swept in parallel, so that two threads take that path). Returns the capped
+/// steps, the worst capped residual over the Gauss–Seidel tolerance, and the bits of the final
+/// displacements, contact forces and states.
+fn coarse_wedge_caps(angles: [Option<f64>; 2], duration: f64, threads: usize, shared_passes: usize) -> (u64, f64, Vec<u64>) {
+    use jointquake::simulation::Simulation;
+    let sc = coarse_wedge_demo(angles, duration);
+    let pb = jointquake::problem::Problem::build(sc, Mesh::from_msh(fixture("wedge_coarse.msh")).unwrap()).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    pool.install(|| {
+        let mut sim = Simulation::new(&pb).unwrap();
+        let c = sim.contact.as_mut().unwrap();
+        c.gs_shared_passes = shared_passes;
+        c.sweep_par_min = 4;
+        sim.equilibrate().unwrap();
+        for _ in 0..sim.n_steps() {
+            sim.step().unwrap();
+        }
+        let tol = sim.contact.as_ref().unwrap().gs_tolerance;
+        let r = &sim.state.contact.joints[0];
+        let mut bits: Vec<u64> = sim.state.u.iter().map(|v| v.to_bits()).collect();
+        for j in &sim.state.contact.joints {
+            bits.extend(j.pairs.iter().flat_map(|p| [p.r_n.to_bits(), p.r_t[0].to_bits(), p.r_t[1].to_bits(), p.slip.to_bits(), p.state as u64]));
+        }
+        (r.unconverged_steps, r.max_gs_residual / tol, bits)
+    })
+}
+
+/// Issue 32 §4: on the wedge's line of intersection a slave node has a pair on joint A and one on
+/// joint B. Under the seed's truncated Mohr–Coulomb cone a closed pair at r_n → 0 still carries
+/// c A and an open one nothing, so the node's two-pair problem has no consistent state and the
+/// Gauss–Seidel sweeps cycle to their cap (the demo's WARNING). With the bilinear (Patton)
+/// envelope (τ ≤ min(tan(φ + i) σ, c + σ tan φ), i = 15° on both joints) and the shared-node pass
+/// they converge. Case: the coarse wedge demo (El Centro at 1.0 g) for its first 3.2 s, where the
+/// full seed run has its worst capped step (t = 2.996 s, node 133, A slip / B open, 4.2e-6 m).
+/// Asserted: the seed's law stops at the cap with a residual above the warning's 10 × the
+/// tolerance (measured: 20 capped steps, 5.4e4 × tol); the envelope with its shared-node pass
+/// does not reach that (at most 10 ×, i.e. no WARNING; measured: no capped step) and caps fewer
+/// steps than the envelope without the pass (measured: 25, up to 8.6 × tol: the pass pays); and
+/// the envelope's run with its shared-node pass is bit-identical on one and two threads
+/// (reference: one thread; tolerance: none). About 2.5 s of CPU.
+#[test]
+fn patton_envelope_ends_the_wedge_line_of_intersection_cycle() {
+    let t = 3.2;
+    let (seed_caps, seed_res, _) = coarse_wedge_caps([None, None], t, 1, 50);
+    let (caps, res, one) = coarse_wedge_caps([Some(15.0), Some(15.0)], t, 1, 50);
+    let (bare_caps, bare_res, _) = coarse_wedge_caps([Some(15.0), Some(15.0)], t, 1, 0);
+    eprintln!("first {t} s, capped steps / worst residual over tol: seed {seed_caps} / {seed_res:.3e}; i = 15° with the shared-node pass {caps} / {res:.3e}, without it {bare_caps} / {bare_res:.3e}");
+    assert!(seed_caps > 0 && seed_res > 10.0, "the seed's law must cycle here: {seed_caps} capped steps, residual {seed_res} × tol");
+    assert!(res <= 10.0, "the envelope still cycles: {caps} capped steps, residual {res} × tol");
+    assert!(caps < bare_caps, "the shared-node pass does not pay: {caps} capped steps with it, {bare_caps} without");
+    let (_, _, two) = coarse_wedge_caps([Some(15.0), Some(15.0)], t, 2, 50);
+    assert!(one == two, "two threads: the envelope's run with the shared-node pass differs from one thread");
+}
+
+/// An asperity angle is checked where the scene is read, naming the joint, the field and the
+/// fix: i must be in (0, 90° − φ) (joint A: φ = 20°), the joint needs cohesion, and excludes a
+/// tensile strength and a tie.
+#[test]
+fn asperity_angle_out_of_range_or_misplaced_is_refused_naming_the_field() {
+    let with = |fields: Value| {
+        let mut v = wedge_scene(json!({}));
+        for (k, x) in fields.as_object().unwrap() {
+            v["joints"][0][k] = x.clone();
+        }
+        scene(v).validate()
+    };
+    assert!(with(json!({"asperity_angle": 15})).is_ok());
+    for (fields, says) in [
+        (json!({"asperity_angle": 70}), "(0, 70.000) deg"),
+        (json!({"asperity_angle": 0}), "(0, 70.000) deg"),
+        (json!({"asperity_angle": -5}), "measured first-order asperity angle"),
+        (json!({"asperity_angle": 15, "cohesion": 0}), "needs `cohesion` > 0"),
+        (json!({"asperity_angle": 15, "tensile_strength": 1e5}), "exclude each other"),
+        (json!({"asperity_angle": 15, "tied": true}), "tied joint"),
+    ] {
+        let e = with(fields.clone()).expect_err(&fields.to_string());
+        assert!(e.contains("joint \"A\": asperity_angle") && e.contains(says), "{fields}: {e}");
+    }
 }

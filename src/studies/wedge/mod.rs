@@ -17,8 +17,9 @@
 //!   `loads.gravity.groups`); "rigid" when the run scene fixes one of them, "massless" when one
 //!   of them is `massless` (condensed, with the weightless massive layer under the joints,
 //!   docs/dam_physics.md), else "elastic";
-//! - joint law ([`report::CohesionLaw`]): the first joint's `keep_cohesion` /
-//!   `softening_slip`; the base scene's law is the headline, any other is a variant;
+//! - joint law ([`report::CohesionLaw`]): the first joint's `asperity_angle` (the bilinear
+//!   envelope) / `keep_cohesion` / `softening_slip`; the base scene's law is the headline, every
+//!   other is a variant with its own section and chart;
 //! - stiffness-proportional damping β: the run scene's `damping` (the base scene's β is the
 //!   headline's, any other a variant).
 //!

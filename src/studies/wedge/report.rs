@@ -103,10 +103,16 @@ pub enum CohesionLaw {
     Softening { slip: f64 },
     /// Cohesion lost at a pair's first slip or opening.
     Brittle,
+    /// The bilinear (Patton 1966) envelope min(tan(φ + i) σ, c + σ tan φ) of the joints'
+    /// `asperity_angle` i [deg], with the cohesion kept (`kept`) or lost after slip.
+    Patton { asperity_angle: f64, kept: bool },
 }
 
 impl CohesionLaw {
     fn of(j: &crate::scene::JointSceneSpec) -> CohesionLaw {
+        if let Some(i) = j.asperity_angle {
+            return CohesionLaw::Patton { asperity_angle: i, kept: j.keep_cohesion == Some(true) };
+        }
         match (j.keep_cohesion, j.softening_slip) {
             (Some(true), _) => CohesionLaw::Kept,
             (_, Some(d)) if d > 0.0 => CohesionLaw::Softening { slip: d },
@@ -119,12 +125,22 @@ impl CohesionLaw {
             CohesionLaw::Kept => "cohesion kept (Mohr-Coulomb, no softening: the seed's law)".into(),
             CohesionLaw::Softening { slip } => format!("cohesion lost after slip (softening to zero over {} mm)", fmt_sig_short(slip * 1e3)),
             CohesionLaw::Brittle => "cohesion lost at the first slip (brittle)".into(),
+            CohesionLaw::Patton { asperity_angle, kept } => format!("bilinear (Patton) envelope, asperity angle i = {}°, cohesion {}", fmt_sig_short(asperity_angle), if kept { "kept" } else { "lost after slip" }),
         }
     }
 
-    /// The rigid block's bond for this law: kept, or lost at the first slide.
+    /// The rigid block's bond for this law: kept, or lost at the first slide (the rigid block
+    /// has the Mohr–Coulomb cone; with the Patton envelope, that of its cohesion).
     pub fn bond(self) -> Bond {
-        if self == CohesionLaw::Kept { Bond::Kept } else { Bond::Brittle }
+        match self {
+            CohesionLaw::Kept | CohesionLaw::Patton { kept: true, .. } => Bond::Kept,
+            _ => Bond::Brittle,
+        }
+    }
+
+    /// The rigid block's label for this law's bond.
+    pub fn rigid_label(self) -> &'static str {
+        if self.bond() == Bond::Kept { "cohesion kept" } else { "cohesion lost at first slide" }
     }
 }
 
@@ -534,8 +550,9 @@ struct Ctx<'a> {
     main_rock: RockModel,
     main_law: CohesionLaw,
     main_beta: f64,
-    /// The variant law (the first law of the runs that is not the headline's), if any.
-    other_law: Option<CohesionLaw>,
+    /// The variant laws (the laws of the runs that are not the headline's, in the order of the
+    /// runs), if any.
+    other_laws: Vec<CohesionLaw>,
     /// The accuracy PGA [g].
     acc: f64,
     charts_dir: PathBuf,
@@ -561,9 +578,9 @@ impl Ctx<'_> {
         self.plain(s) && s.mesh == self.reference && s.method == "nts" && s.layer == self.prm.reference.layer
     }
 
-    /// A run of the variant law (otherwise as the headline).
-    fn variant(&self, s: &WedgeRunSpec) -> bool {
-        Some(s.law) == self.other_law && s.e_factor == 1.0 && s.rock == self.main_rock && s.beta == self.main_beta
+    /// A run of the variant law `law` (otherwise as the headline).
+    fn variant(&self, s: &WedgeRunSpec, law: CohesionLaw) -> bool {
+        s.law == law && s.e_factor == 1.0 && s.rock == self.main_rock && s.beta == self.main_beta
     }
 
     /// The first run that did not fail among those `pred` selects.
@@ -601,36 +618,57 @@ impl Ctx<'_> {
     }
 }
 
-/// Residual slip against PGA of the headline's levels, the rigid block and the variant law.
+/// Residual slip against PGA of the headline's levels, the rigid block and the variant laws.
 struct Curves {
     nts_sweep: Vec<(f64, f64)>,
     ntn_sweep: Vec<(f64, f64)>,
     nts2_sweep: Vec<(f64, f64)>,
     reference_pts: Vec<(f64, f64)>,
     rigid_kept_pts: Vec<(f64, f64)>,
-    nts_var: Vec<(f64, f64)>,
-    ntn_var: Vec<(f64, f64)>,
+    /// Per variant law (`Ctx::other_laws`' order): its NTS-L1 and NTN curves on the sweep mesh.
+    variants: Vec<VariantCurves>,
+}
+
+/// The slip against PGA of one variant law: NTS-L1 and NTN on the sweep mesh.
+struct VariantCurves {
+    law: CohesionLaw,
+    nts: Vec<(f64, f64)>,
+    ntn: Vec<(f64, f64)>,
+}
+
+impl VariantCurves {
+    /// Whether the variant law has runs to report.
+    fn has_runs(&self) -> bool {
+        !self.nts.is_empty() || !self.ntn.is_empty()
+    }
+
+    /// The stem of its chart: `slip_vs_pga_variant` for the first variant, then
+    /// `slip_vs_pga_variant2`, ...
+    fn chart_stem(k: usize) -> String {
+        if k == 0 { "slip_vs_pga_variant".into() } else { format!("slip_vs_pga_variant{}", k + 1) }
+    }
 }
 
 impl Curves {
     fn of(ctx: &Ctx<'_>) -> Curves {
         let plain = |s: &WedgeRunSpec| ctx.plain(s);
-        let variant = |s: &WedgeRunSpec| ctx.variant(s);
         let sweep = &ctx.sweep;
+        let variants = ctx
+            .other_laws
+            .iter()
+            .map(|&law| {
+                let variant = |s: &WedgeRunSpec| ctx.variant(s, law);
+                VariantCurves { law, nts: ctx.pts("nts", sweep, 1, &variant), ntn: ctx.pts("ntn", sweep, 1, &variant) }
+            })
+            .collect();
         Curves {
             nts_sweep: ctx.pts("nts", sweep, 1, &plain),
             ntn_sweep: ctx.pts("ntn", sweep, 1, &plain),
             nts2_sweep: ctx.pts("nts", sweep, 2, &plain),
             reference_pts: ctx.pts("nts", &ctx.reference, ctx.prm.reference.layer, &plain),
             rigid_kept_pts: ctx.pgas.iter().map(|&p| (p, ctx.rigid_main(p))).collect(),
-            nts_var: ctx.pts("nts", sweep, 1, &variant),
-            ntn_var: ctx.pts("ntn", sweep, 1, &variant),
+            variants,
         }
-    }
-
-    /// Whether the variant law has runs to report.
-    fn has_variant(&self) -> bool {
-        !self.nts_var.is_empty() || !self.ntn_var.is_empty()
     }
 }
 
@@ -698,7 +736,12 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     };
     // the headline: the base scene's law, damping and stiffness on the main rock
     let main_law = base.joints.first().map(CohesionLaw::of).unwrap_or(CohesionLaw::Brittle);
-    let other_law = runs.iter().map(|r| r.spec.law).find(|l| *l != main_law);
+    let mut other_laws: Vec<CohesionLaw> = Vec::new();
+    for l in runs.iter().map(|r| r.spec.law).filter(|l| *l != main_law) {
+        if !other_laws.contains(&l) {
+            other_laws.push(l);
+        }
+    }
     let ctx = Ctx {
         prm,
         results,
@@ -712,7 +755,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
         main_rock: kind.main_rock(),
         main_law,
         main_beta: stiffness_damping(base),
-        other_law,
+        other_laws,
         acc: prm.accuracy_pga,
         charts_dir: results.plan.out.join("charts"),
     };
@@ -720,7 +763,7 @@ pub fn write(kind: &WedgeKind, results: &StudyResults) -> Result<KindReport, Err
     let at = AtAcc::of(&ctx);
     let sa = speed_accuracy(&ctx, &at);
     let mut charts = vec![chart_slip_vs_pga(&ctx, &curves)?];
-    charts.extend(chart_slip_vs_pga_variant(&ctx, &curves)?);
+    charts.extend(chart_slip_vs_pga_variants(&ctx, &curves)?);
     charts.extend(chart_slip_vs_pga_rock(&ctx)?);
     charts.push(chart_slip_history(&ctx, &at)?);
     charts.push(chart_p1_history(&ctx, &at)?);
@@ -783,22 +826,27 @@ fn chart_slip_vs_pga(ctx: &Ctx<'_>, cv: &Curves) -> Result<PathBuf, Error> {
     if reference != sweep && !cv.reference_pts.is_empty() {
         c.series.push(Series::markers(format!("NTS-L{}, {reference} mesh (reference)", ctx.prm.reference.layer), cv.reference_pts.clone()));
     }
-    c.series.push(Series::line_markers(format!("rigid block, {}", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), cv.rigid_kept_pts.clone()));
+    c.series.push(Series::line_markers(format!("rigid block, {}", main_law.rigid_label()), cv.rigid_kept_pts.clone()));
     c.series.push(Series::markers("seed NTS (Koyna record)", [(seed::PGA, seed::SLIP_NTS_1G)]));
     c.series.push(Series::markers("seed NTN (Koyna record)", [(seed::PGA, seed::SLIP_NTN_1G)]));
     Ok(c.write_png_svg(&ctx.charts_dir.join("slip_vs_pga"))?.png)
 }
 
-/// Chart: slip against PGA with the variant law (none without variant runs).
-fn chart_slip_vs_pga_variant(ctx: &Ctx<'_>, cv: &Curves) -> Result<Option<PathBuf>, Error> {
-    let Some(law) = ctx.other_law.filter(|_| cv.has_variant()) else { return Ok(None) };
+/// Charts: slip against PGA with each variant law that has runs
+/// ([`VariantCurves::chart_stem`]).
+fn chart_slip_vs_pga_variants(ctx: &Ctx<'_>, cv: &Curves) -> Result<Vec<PathBuf>, Error> {
     let (sweep, main_law) = (&ctx.sweep, ctx.main_law);
-    let mut c = Chart::new(format!("Residual slip at P2 against PGA — variant: {}", law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
-    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), cv.nts_var.clone()));
-    c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), cv.ntn_var.clone()));
-    c.series.push(Series::line_markers("rigid block, cohesion lost at first slide", ctx.pgas.iter().map(|&p| (p, ctx.rigid_of(p).bond(law).result.residual_displacement))));
-    c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {} (headline)", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "headline law" }), cv.nts_sweep.clone()));
-    Ok(Some(c.write_png_svg(&ctx.charts_dir.join("slip_vs_pga_variant"))?.png))
+    let mut out = Vec::new();
+    for (k, v) in cv.variants.iter().enumerate().filter(|(_, v)| v.has_runs()) {
+        let law = v.law;
+        let mut c = Chart::new(format!("Residual slip at P2 against PGA — variant: {}", law.describe()), "horizontal PGA [g]", "residual slip along the line of intersection [m]");
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh"), v.nts.clone()));
+        c.series.push(Series::line_markers(format!("NTN, {sweep} mesh"), v.ntn.clone()));
+        c.series.push(Series::line_markers(format!("rigid block, {}", law.rigid_label()), ctx.pgas.iter().map(|&p| (p, ctx.rigid_of(p).bond(law).result.residual_displacement))));
+        c.series.push(Series::line_markers(format!("NTS-L1, {sweep} mesh, {} (headline)", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "headline law" }), cv.nts_sweep.clone()));
+        out.push(c.write_png_svg(&ctx.charts_dir.join(VariantCurves::chart_stem(k)))?.png);
+    }
+    Ok(out)
 }
 
 /// Chart: slip against PGA of the other rock models against the main rock (none without
@@ -931,9 +979,8 @@ fn cheapest_levels(ctx: &Ctx<'_>) -> Vec<(f64, String, f64, f64)> {
 /// The trend of NTS against NTN, for the headline and the variant.
 fn trends(ctx: &Ctx<'_>, cv: &Curves) -> Vec<String> {
     let mut trend = Vec::new();
-    let variant_label = ctx.other_law.map(|l| format!("variant ({})", l.describe()));
-    for (label, nts, ntn) in [(Some(format!("headline ({})", ctx.main_law.describe())), &cv.nts_sweep, &cv.ntn_sweep), (variant_label, &cv.nts_var, &cv.ntn_var)] {
-        let Some(label) = label else { continue };
+    let variants = cv.variants.iter().map(|v| (format!("variant ({})", v.law.describe()), &v.nts, &v.ntn));
+    for (label, nts, ntn) in std::iter::once((format!("headline ({})", ctx.main_law.describe()), &cv.nts_sweep, &cv.ntn_sweep)).chain(variants) {
         trend.extend(nts_ntn_trend(&label, &ctx.pgas, nts, ntn));
     }
     trend
@@ -1069,7 +1116,7 @@ fn section_model(md: &mut String, ctx: &Ctx<'_>) {
         })
         .collect::<Vec<_>>()
         .join("; ");
-    let _ = writeln!(md, "- Joints: {strength} (seed table 1). Headline: {}{}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).", ctx.main_law.describe(), ctx.other_law.map(|l| format!("; variant: {}", l.describe())).unwrap_or_default());
+    let _ = writeln!(md, "- Joints: {strength} (seed table 1). Headline: {}{}; during gravity equilibrium bonds are kept (`equilibrium.joint_bonds = \"kept\"`).", ctx.main_law.describe(), ctx.other_laws.iter().map(|l| format!("; variant: {}", l.describe())).collect::<String>());
     let grav = base.loads.gravity.as_ref().and_then(|g| g.groups.clone()).map(|g| g.join(", ")).unwrap_or_else(|| "all".into());
     let _ = writeln!(md, "- Gravity on: {grav} (the rock is a weightless support, as in limit equilibrium); brought to equilibrium before the record.");
     let others = ctx.other_rocks();
@@ -1145,7 +1192,7 @@ fn section_headline(md: &mut String, ctx: &Ctx<'_>, cv: &Curves, at: &AtAcc<'_>)
     if has_ref {
         head.push(format!("NTS-L{} {reference}", prm.reference.layer));
     }
-    head.extend([format!("rigid block ({})", if main_law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost" }), "(NTS − NTN)/NTN".into(), "seed NTS / NTN".into()]);
+    head.extend([format!("rigid block ({})", if main_law.bond() == Bond::Kept { "cohesion kept" } else { "cohesion lost" }), "(NTS − NTN)/NTN".into(), "seed NTS / NTN".into()]);
     let mut t = Table::new(head);
     for &p in pgas {
         let mut row = vec![fmt_sig_short(p), val(&nts_sweep, p), val(&ntn_sweep, p)];
@@ -1231,37 +1278,38 @@ fn detail_table(md: &mut String, ctx: &Ctx<'_>, sel: &dyn Fn(&WedgeRunSpec) -> b
             let _ = t.push_row([fmt_sig_short(p), r.level.clone(), m(r.p1_residual[0]), m(r.p1_residual[1]), m(r.p1_residual[2]), slip, (if r.still_sliding { "yes" } else { "no" }).into(), r.mode.clone(), op]);
         }
         let rg = ctx.rigid_of(p).bond(law);
-        let _ = t.push_row([fmt_sig_short(p), format!("rigid block, {}", if law == CohesionLaw::Kept { "cohesion kept" } else { "cohesion lost at first slide" }), "".into(), "".into(), "".into(), m(rg.result.residual_displacement), (if rg.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.result.n_episodes), "".into()]);
+        let _ = t.push_row([fmt_sig_short(p), format!("rigid block, {}", law.rigid_label()), "".into(), "".into(), "".into(), m(rg.result.residual_displacement), (if rg.result.still_sliding { "yes" } else { "no" }).into(), format!("{} sliding episodes", rg.result.n_episodes), "".into()]);
     }
     md.push_str(&t.to_markdown());
 }
 
-/// Section: "Variant" (the variant law's slip against PGA, its chart and its runs in detail;
-/// nothing without variant runs).
+/// Section: "Variant" per variant law (its slip against PGA, its chart and its runs in detail;
+/// nothing for a law without runs).
 fn section_variant(md: &mut String, ctx: &Ctx<'_>, cv: &Curves) {
-    let (sweep, main_rock, main_beta, other_law, pgas): (&str, _, _, _, _) = (&ctx.sweep, ctx.main_rock, ctx.main_beta, ctx.other_law, &ctx.pgas);
-    let Curves { nts_sweep, nts_var, ntn_var, .. } = cv;
+    let (sweep, main_rock, main_beta, pgas): (&str, _, _, _) = (&ctx.sweep, ctx.main_rock, ctx.main_beta, &ctx.pgas);
+    let nts_sweep = &cv.nts_sweep;
     let rigid_of = |p: f64| ctx.rigid_of(p);
-    // ---- 2. the variant law
-    if let Some(law) = other_law.filter(|_| !nts_var.is_empty() || !ntn_var.is_empty()) {
+    // ---- 2. the variant laws
+    for (k, v) in cv.variants.iter().enumerate().filter(|(_, v)| v.has_runs()) {
+        let (law, nts_var, ntn_var) = (v.law, &v.nts, &v.ntn);
         let _ = writeln!(md, "## Variant: {}\n", law.describe());
-        let _ = writeln!(md, "The same runs ({}, {sweep} mesh, β = {} s) with the joints' cohesion lost after slip: not the seed's law; residual slip at P2 [m].\n", main_rock.describe(), fmt_sig(main_beta, 3));
-        let mut t = Table::new(["PGA [g]".to_string(), format!("NTS-L1 {sweep}"), format!("NTN {sweep}"), "(NTS − NTN)/NTN".into(), "rigid block, cohesion lost at first slide".into(), format!("NTS-L1 {sweep}, headline")]);
+        let rigid_note = if matches!(law, CohesionLaw::Patton { .. }) { " (the rigid block keeps the Mohr–Coulomb cone)" } else { "" };
+        let _ = writeln!(md, "The same runs ({}, {sweep} mesh, β = {} s) with the joints' law changed to: {}; not the seed's law{rigid_note}; residual slip at P2 [m].\n", main_rock.describe(), fmt_sig(main_beta, 3), law.describe());
+        let mut t = Table::new(["PGA [g]".to_string(), format!("NTS-L1 {sweep}"), format!("NTN {sweep}"), "(NTS − NTN)/NTN".into(), format!("rigid block, {}", law.rigid_label()), format!("NTS-L1 {sweep}, headline")]);
         for &p in pgas.iter().filter(|&&p| nts_var.iter().chain(ntn_var.iter()).any(|x| x.0 == p)) {
             let d = match (nts_var.iter().find(|x| x.0 == p), ntn_var.iter().find(|x| x.0 == p)) {
                 (Some(a), Some(b)) if a.1.max(b.1) >= 0.01 => fmt_percent((a.1 - b.1) / b.1, 1),
                 (Some(_), Some(_)) => "(< 1 cm)".into(),
                 _ => "–".into(),
             };
-            let _ = t.push_row([fmt_sig_short(p), val(&nts_var, p), val(&ntn_var, p), d, m(rigid_of(p).bond(law).result.residual_displacement), val(&nts_sweep, p)]);
+            let _ = t.push_row([fmt_sig_short(p), val(nts_var, p), val(ntn_var, p), d, m(rigid_of(p).bond(law).result.residual_displacement), val(nts_sweep, p)]);
         }
         md.push_str(&t.to_markdown());
-        let _ = writeln!(md, "\n![slip against PGA, variant](charts/slip_vs_pga_variant.svg)\n");
+        let _ = writeln!(md, "\n![slip against PGA, variant](charts/{}.svg)\n", VariantCurves::chart_stem(k));
         let _ = writeln!(md, "### Variant runs in detail\n");
-        detail_table(md, ctx, &|s| ctx.variant(s), law);
+        detail_table(md, ctx, &|s| ctx.variant(s, law), law);
         let _ = writeln!(md);
     }
-
 }
 
 /// Section: "Rock model" (each run on another rock against its main-rock twin; nothing without
