@@ -37,7 +37,10 @@
 //! (its search and sweeps run on all threads), and the contact's parts on that count; a
 //! loaded machine shares its cores, so time the threads on an idle one). Every run also prints
 //! the process's CPU time per step (all threads; /proc/self/task/*/schedstat), which a load on
-//! the machine inflates far less than the wall time.
+//! the machine inflates far less than the wall time, and the parallel regions (rayon
+//! fork-joins, `jointquake::par`) a step opens on each thread count; and per mesh the element
+//! chunks and colours, and the speed-up the element loop's schedule allows on two threads
+//! (`element_schedule_bounds`: colour by colour, and on the chunk graph), which no load changes.
 //! Then the step with each reservoir model against Westergaard's (`reservoir_models`, knob
 //! `JQ_DAM_RESERVOIR`, default "coarse"). Then the static state (`static_state`, knob
 //! `JQ_DAM_STATIC`) and the static stages' fill with AMD and nested dissection (`static_fill`,
@@ -52,6 +55,11 @@ use jointquake::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::Instant;
+
+/// A hex8's work in the element loop over a tet4's (`element_schedule_bounds`): 5, the ratio of
+/// their one-thread rates on the structured boxes of docs/performance.md §1 (95 ns and 18 ns an
+/// element).
+const HEX_WEIGHT: f64 = 5.0;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -180,22 +188,24 @@ fn main() {
                 let events0: Vec<(u64, u64, u64, u64)> = sim.state.contact.joints.iter().map(|j| (j.events.fresh_searches, j.events.recentred, j.events.lost, j.events.projection_failures)).collect();
                 sim.contact.as_mut().expect("joints").timings = Some(Default::default());
                 let mut per_step = Vec::new();
-                let cpu0 = cpu_s();
+                let (cpu0, fj0) = (cpu_s(), jointquake::par::fork_joins());
                 for _ in 0..repeats {
                     per_step.push(step(steps, &mut sim, &mut sweeps) / steps as f64);
                 }
                 let timed = (repeats * steps) as f64;
                 let cpu_step = (cpu_s() - cpu0) / timed;
+                let forks_step = (jointquake::par::fork_joins() - fj0) as f64 / timed;
                 let parts = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
                 // the same steps on each further thread count (after the one-thread steps: the
                 // state moves on, the contact's pairs and sweeps stay about the same)
                 let mut threads_rows = Vec::new();
                 for (nt, p) in pools.iter().skip(1) {
-                    let (mut sw, c0) = (0usize, cpu_s());
+                    let (mut sw, c0, fj) = (0usize, cpu_s(), jointquake::par::fork_joins());
                     sim.contact.as_mut().expect("joints").timings = Some(Default::default());
                     let t: Vec<f64> = p.install(|| (0..repeats).map(|_| step(steps, &mut sim, &mut sw) / steps as f64).collect());
                     let pt = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
-                    threads_rows.push((*nt, t, (cpu_s() - c0) / timed, sw as f64 / timed, pt));
+                    let forks = (jointquake::par::fork_joins() - fj) as f64 / timed;
+                    threads_rows.push((*nt, t, (cpu_s() - c0) / timed, sw as f64 / timed, pt, forks));
                 }
                 let sweeps_per_step = sweeps as f64 / timed;
                 let unconverged: u64 = sim.state.contact.joints.iter().map(|j| j.unconverged_steps).sum();
@@ -225,26 +235,39 @@ fn main() {
                     }
                     println!("  {size}, rock {rock}: condensation {:?}, {} condensed on {} interface unknowns, factor {} entries, S {:.1} MB, setup {:.2} s; per step: solve {:.3} ms, S·u_b {:.3} ms", i.method, i.condensed_unknowns, i.interface_unknowns, i.factor_entries, i.schur_bytes as f64 / 1e6, i.setup_time, cond_ms.0, cond_ms.1);
                 }
+                let sched = |s: &jointquake::model::Schedule| (s.chunks.len(), s.colors.len());
+                let (tsched, hsched) = (sched(&model.tets.schedule), sched(&model.hexes.schedule));
                 println!(
-                    "  {size}, rock {rock}: {} nodes, {ne} elements ({hexes} hex8, {} tet4), {} slave nodes ({joint_slaves} on the 28 joints), {active} pairs in compression",
+                    "  {size}, rock {rock}: {} nodes, {ne} elements ({hexes} hex8 with {} shapes, {} tet4), {} slave nodes ({joint_slaves} on the 28 joints), {active} pairs in compression; element chunks / colours: tet4 {} / {}, hex8 {} / {}",
                     model.n_nodes(),
+                    model.hexes.shapes.len(),
                     ne - hexes,
-                    slaves
+                    slaves,
+                    tsched.0,
+                    tsched.1,
+                    hsched.0,
+                    hsched.1
                 );
+                // the element loop's speed-up bound from its schedule (the Schur path skips the
+                // massless rock's elements)
+                let skip = found.as_ref().is_some_and(|i| i.method == CondensationMethod::Schur);
+                let nt_max = threads.iter().copied().max().unwrap_or(1).max(2);
+                let (bound_colours, bound_graph) = element_schedule_bounds(model, skip, HEX_WEIGHT, nt_max);
+                println!("    element loop on {nt_max} threads, the speed-up its schedule allows (work per chunk: its elements assembled, a hex8 = {HEX_WEIGHT} tet4): colour by colour {bound_colours:.2}×, chunk graph {bound_graph:.2}×");
                 println!("    mesh {t_mesh:.2} s, model build and tagging {t_build:.2} s; stable dt {dt_stable:.4e} s (critical element {} in {}), dt {dt:.4e} s", model.critical.tag, model.critical.group);
                 println!("    step {:.3} / {:.3} ms (best / median of {repeats} × {steps}); {:.3} µs per element; contact {:.3} ms per step = {:.3} µs per slave node", 1e3 * b, 1e3 * m, 1e6 * m / ne as f64, 1e3 * contact, 1e6 * contact / slaves.max(1) as f64);
                 let part = |d: std::time::Duration| d.as_secs_f64() / parts.steps.max(1) as f64 / m;
                 let shares = [part(parts.search), part(parts.prepare), part(parts.sweeps), part(parts.record)];
                 // the search and the sweeps run on all threads; the set-up and record on one
                 let serial = shares[1] + shares[3];
-                println!("    CPU time {:.3} ms per step ({} thread{}, all threads); the contact {:.0} % of the step: search {:.0} %, prepare {:.0} %, sweeps {:.0} %, record {:.0} % (serial: prepare and record)", 1e3 * cpu_step, pools[0].0, if pools[0].0 == 1 { "" } else { "s" }, 1e2 * contact / m, 1e2 * shares[0], 1e2 * shares[1], 1e2 * shares[2], 1e2 * shares[3]);
+                println!("    CPU time {:.3} ms per step ({} thread{}, all threads), {forks_step:.1} fork-joins per step; the contact {:.0} % of the step: search {:.0} %, prepare {:.0} %, sweeps {:.0} %, record {:.0} % (serial: prepare and record)", 1e3 * cpu_step, pools[0].0, if pools[0].0 == 1 { "" } else { "s" }, 1e2 * contact / m, 1e2 * shares[0], 1e2 * shares[1], 1e2 * shares[2], 1e2 * shares[3]);
                 let mut threads_json = Vec::new();
-                for (nt, t, cpu, sw, pt) in &threads_rows {
+                for (nt, t, cpu, sw, pt, forks) in &threads_rows {
                     let amdahl = 1.0 / (serial + (1.0 - serial) * pools[0].0 as f64 / *nt as f64);
                     let ms = |d: std::time::Duration| 1e3 * d.as_secs_f64() / pt.steps.max(1) as f64;
                     let parts_ms = [ms(pt.search), ms(pt.prepare), ms(pt.sweeps), ms(pt.record)];
-                    println!("    {nt} threads: step {:.3} / {:.3} ms, {:.2}× the {}-thread median (Amdahl bound with the contact's set-up and record serial: {amdahl:.2}×); CPU time {:.3} ms per step; {sw:.1} sweeps per step; contact {:.3} ms (search {:.3}, prepare {:.3}, sweeps {:.3}, record {:.3})", 1e3 * best(t), 1e3 * median(t), m / median(t), pools[0].0, 1e3 * cpu, parts_ms.iter().sum::<f64>(), parts_ms[0], parts_ms[1], parts_ms[2], parts_ms[3]);
-                    threads_json.push(serde_json::json!({"threads": nt, "step_s": t, "best_step_s": best(t), "median_step_s": median(t), "speedup_median": m / median(t), "amdahl_bound": amdahl, "cpu_s_per_step": cpu, "gs_sweeps_per_step": sw, "contact_ms_search_prepare_sweeps_record": parts_ms}));
+                    println!("    {nt} threads: step {:.3} / {:.3} ms, {:.2}× the {}-thread median (Amdahl bound with the contact's set-up and record serial: {amdahl:.2}×); CPU time {:.3} ms per step; {forks:.1} fork-joins per step; {sw:.1} sweeps per step; contact {:.3} ms (search {:.3}, prepare {:.3}, sweeps {:.3}, record {:.3})", 1e3 * best(t), 1e3 * median(t), m / median(t), pools[0].0, 1e3 * cpu, parts_ms.iter().sum::<f64>(), parts_ms[0], parts_ms[1], parts_ms[2], parts_ms[3]);
+                    threads_json.push(serde_json::json!({"threads": nt, "step_s": t, "best_step_s": best(t), "median_step_s": median(t), "speedup_median": m / median(t), "amdahl_bound": amdahl, "cpu_s_per_step": cpu, "fork_joins_per_step": forks, "gs_sweeps_per_step": sw, "contact_ms_search_prepare_sweeps_record": parts_ms}));
                 }
                 println!(
                     "    Gauss–Seidel {sweeps_per_step:.1} sweeps per step ({unconverged} unconverged steps since the start); per timed step: {:.2} fresh searches, {:.2} recentred, {:.2} lost, {:.2} projection failures",
@@ -267,7 +290,7 @@ fn main() {
                     "contact_s_per_step": contact, "contact_us_per_slave_node": 1e6 * contact / slaves.max(1) as f64,
                     "wall_s_per_earthquake_second": per_second, "gs_sweeps_per_step": sweeps_per_step, "unconverged_steps": unconverged,
                     "fresh_searches_per_step": fresh as f64 / timed, "recentred_per_step": recentred as f64 / timed, "lost_per_step": lost as f64 / timed, "mesh_s": t_mesh, "build_s": t_build,
-                    "threads": pools[0].0, "cpu_s_per_step": cpu_step, "contact_share": contact / m, "serial_share": serial, "contact_shares_search_prepare_sweeps_record": shares, "other_threads": threads_json,
+                    "threads": pools[0].0, "cpu_s_per_step": cpu_step, "fork_joins_per_step": forks_step, "element_schedule_bound_colours": bound_colours, "element_schedule_bound_graph": bound_graph, "hex8_shapes": model.hexes.shapes.len(), "chunks_colours_tet4_hex8": [tsched, hsched], "contact_share": contact / m, "serial_share": serial, "contact_shares_search_prepare_sweeps_record": shares, "other_threads": threads_json,
                 }));
             }
         }
@@ -590,4 +613,56 @@ fn static_state() -> Vec<serde_json::Value> {
         }
     }
     rows
+}
+
+/// The element loop's speed-up on `threads` threads that its schedule allows, from the work of
+/// each chunk alone (no memory or hand-off costs): the work of a chunk is its elements that the
+/// step assembles (the massless rock's are skipped with `skip_massless`), a hex8 weighing
+/// `w_hex` tet4. Returns (colour by colour, each colour's chunks shared out in order to the
+/// first free thread and all threads waiting for the colour's last chunk: the loop before
+/// `model::ChunkGraph`; the chunk graph, a free thread taking the lowest-numbered ready chunk).
+fn element_schedule_bounds(model: &jointquake::model::Model, skip_massless: bool, w_hex: f64, threads: usize) -> (f64, f64) {
+    let mut work = Vec::new();
+    let mut colours = Vec::new();
+    for (s, cells, w) in [(&model.tets.schedule, &model.tets.cell, 1.0), (&model.hexes.schedule, &model.hexes.cell, w_hex)] {
+        let first = work.len();
+        work.extend(s.chunks.iter().map(|r| w * r.clone().filter(|&e| !(skip_massless && model.massless_cells[cells[e] as usize])).count() as f64));
+        colours.extend(s.colors.iter().map(|c| first + c.start..first + c.end));
+    }
+    let total: f64 = work.iter().sum();
+    let barrier: f64 = colours
+        .iter()
+        .map(|c| {
+            let mut free = vec![0.0f64; threads];
+            for k in c.clone() {
+                let t = (0..threads).min_by(|&a, &b| free[a].total_cmp(&free[b])).unwrap();
+                free[t] += work[k];
+            }
+            free.iter().copied().fold(0.0, f64::max)
+        })
+        .sum();
+    // the graph: event by event, a free thread takes the lowest ready chunk
+    let g = &model.chunk_graph;
+    let mut pending: Vec<u32> = (0..g.len()).map(|k| g.predecessors(k)).collect();
+    let mut ready: std::collections::BTreeSet<usize> = (0..g.len()).filter(|&k| pending[k] == 0).collect();
+    let mut running: Vec<(f64, usize)> = Vec::new(); // (finish time, chunk)
+    let (mut now, mut idle) = (0.0f64, threads);
+    while !ready.is_empty() || !running.is_empty() {
+        while idle > 0 && !ready.is_empty() {
+            let k = ready.pop_first().unwrap();
+            running.push((now + work[k], k));
+            idle -= 1;
+        }
+        let i = (0..running.len()).min_by(|&a, &b| running[a].0.total_cmp(&running[b].0)).unwrap();
+        let (t, k) = running.swap_remove(i);
+        now = t;
+        idle += 1;
+        for &j in g.successors(k) {
+            pending[j as usize] -= 1;
+            if pending[j as usize] == 0 {
+                ready.insert(j as usize);
+            }
+        }
+    }
+    (total / barrier, total / now)
 }

@@ -55,6 +55,7 @@ pub mod mesh;
 pub mod model;
 pub mod motion;
 pub mod output;
+pub mod par;
 pub mod pipeline;
 pub mod problem;
 pub mod report;

@@ -149,12 +149,13 @@ fn run_phases(mut scene: Scene, scene_path: &Path, opts: &RunOptions, inspect: &
         summary.write(&out_dir)?;
         Ok(summary)
     };
-    if threads == rayon::current_num_threads() {
-        simulate()
-    } else {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| ModelError::Invalid(format!("cannot start {threads} threads: {e}")))?;
-        pool.install(simulate)
-    }
+    // The run on a worker of a pool of `threads`, also when that is as many as rayon's global
+    // pool has: the step's parallel regions (about 50 a step on the dam, docs/performance.md §7)
+    // then start on a worker, which runs its own part and lets the others steal the rest. Called
+    // from outside a pool (the main thread), each region was injected into the pool while the
+    // main thread slept until a worker had run it: two wake-ups a region, and one thread fewer.
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(|e| ModelError::Invalid(format!("cannot start {threads} threads: {e}")))?;
+    pool.install(simulate)
 }
 
 /// Wall time of a run's stages [s], in order.

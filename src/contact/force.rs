@@ -817,7 +817,12 @@ fn sweep_colors<const LISTED: bool>(active: &mut [Active], order: &[u32], color_
             // share are fixed ones, which no pair writes (`update_pair`)
             unsafe { sweep_pass::<LISTED, 5>(pa, pairs, pl, pe, &mut t, false, laws, mark_tol2, mob_matrix) }
         };
-        moving += if parallel && run.len() >= par_min { run.par_chunks(SWEEP_CHUNK.min(par_min.max(1))).map(pass).sum::<usize>() } else { pass(run) };
+        moving += if parallel && run.len() >= par_min {
+            crate::par::region();
+            run.par_chunks(SWEEP_CHUNK.min(par_min.max(1))).map(pass).sum::<usize>()
+        } else {
+            pass(run)
+        };
     }
     moving
 }
@@ -1013,6 +1018,7 @@ impl ContactSolver<'_> {
         let prediction: &[f64] = u_next;
         let search = |(ji, first, pairs): &mut (usize, usize, &mut [PairRecord]), out: &mut SearchChunk| this.search_chunk_into(model, *ji, *first, pairs, out, dt2, u_prev, u, prediction);
         if rayon::current_num_threads() > 1 {
+            crate::par::region();
             tasks.par_iter_mut().zip(chunks.par_iter_mut()).for_each(|(t, out)| search(t, out));
         } else {
             tasks.iter_mut().zip(chunks.iter_mut()).for_each(|(t, out)| search(t, out));

@@ -47,6 +47,7 @@ fn map_blocks_mut<T: Send>(v: &mut [f64], f: impl Fn(usize, &mut [f64]) -> T + S
     if v.len() < PAR_BLOCKS_MIN * b {
         v.chunks_mut(b).enumerate().map(|(k, x)| f(k, x)).collect()
     } else {
+        crate::par::region();
         v.par_chunks_mut(b).enumerate().map(|(k, x)| f(k, x)).collect()
     }
 }
@@ -59,6 +60,7 @@ fn sum_blocks<const K: usize>(len: usize, f: impl Fn(std::ops::Range<usize>) -> 
     let parts: Vec<[f64; K]> = if n < PAR_BLOCKS_MIN {
         (0..n).map(|k| f(k * b..((k + 1) * b).min(len))).collect()
     } else {
+        crate::par::region();
         (0..n).into_par_iter().map(|k| f(k * b..((k + 1) * b).min(len))).collect()
     };
     add_parts(&parts)

@@ -13,10 +13,11 @@
 //!   active but have no inertia: the explicit step leaves them to a constraint ([`Model::held`]).
 //! - Elements are stored in assembly order ([`Schedule`]): sorted along a Morton (Z-order)
 //!   curve of their centroids, cut into chunks of consecutive elements, and the chunks grouped
-//!   by colour. No two chunks of one colour share a node, so the chunks of a colour are
-//!   assembled in parallel without races, one thread per chunk, each chunk's elements in
-//!   order; the sum order at every node is then fixed by the storage order whatever the
-//!   number of threads (bit-identical results). A chunk's nodes stay in cache while it is
+//!   by colour (no two chunks of one colour share a node). One thread runs the chunks in
+//!   storage order; more threads run a chunk as soon as the chunks before it that share one of
+//!   its nodes are done ([`ChunkGraph`]), each chunk's elements in order on one thread; the sum
+//!   order at every node is then the storage order whatever the number of threads
+//!   (bit-identical results). A chunk's nodes stay in cache while it is
 //!   assembled, so a step streams the nodal vectors about once instead of once per colour.
 //! - Sign: `internal_forces_into` gives f_int = K u; the equation of motion is
 //!   M ü + C u̇ + f_int = F_ext + R.
@@ -38,6 +39,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Assembly order of the elements of one kind: chunks of consecutive elements, grouped by colour.
 #[derive(Clone, Debug, Default)]
@@ -125,6 +127,9 @@ pub struct Model {
     pub materials: Vec<Material>,
     pub tets: Tet4Set,
     pub hexes: Hex8Set,
+    /// Which element chunk must wait for which ([`ChunkGraph`]): the element loop's order on
+    /// more than one thread.
+    pub chunk_graph: ChunkGraph,
     /// Inertial and gravitational mass per node ([`mass`]).
     pub mass: NodalMass,
     /// Fixed components per node: bit 0 = x, 1 = y, 2 = z. Inactive nodes are fully fixed.
@@ -175,9 +180,8 @@ unsafe impl Sync for SharedMut {}
 /// vectors shorter than 4 blocks are zeroed on the calling thread (cheaper than waking others).
 const NODAL_BLOCK: usize = 16384;
 
-/// Elements in a colour below which the colour is assembled on one thread. Default 512: below
-/// that the work of a colour (≈ 10 µs for tet4) is comparable with the cost of waking the
-/// other threads.
+/// Elements of a model below which its element loop runs on one thread. Default 512: below
+/// that the whole loop (≈ 10 µs for tet4) costs about as much as waking the other threads.
 const PAR_MIN: usize = 512;
 
 /// Largest chunk [elements]. Default 2048: the u and f_int entries of a chunk's nodes
@@ -312,26 +316,121 @@ fn permute<T: Clone>(v: &[T], order: &[u32]) -> Vec<T> {
 }
 
 impl Schedule {
-    /// Call `body(e)` for every element `e`: colour after colour; within a colour the chunks in
-    /// parallel (they share no node), each chunk's elements in storage order. `warm(nodes)` runs
-    /// first on each chunk's distinct nodes (ascending): independent loads that bring the
-    /// chunk's nodal data into cache at full memory parallelism, before the element loop's
-    /// gathers, which wait on each other through the scatter (measured: about 10 % faster at 10⁶
-    /// elements, where the nodal vectors do not fit in cache).
-    fn for_each_element(&self, warm: impl Fn(&[u32]) + Sync, body: impl Fn(usize) + Sync) {
-        let run = |k: usize| {
-            warm(&self.chunk_nodes[self.chunk_node_start[k]..self.chunk_node_start[k + 1]]);
-            self.chunks[k].clone().for_each(&body)
-        };
-        // one thread: no pool hand-off per colour (a context switch each time, which on a
-        // 10⁴-element model with contact cost about as much as the elements themselves)
-        let serial = rayon::current_num_threads() == 1;
-        for col in &self.colors {
-            let elements = self.chunks[col.end - 1].end - self.chunks[col.start].start;
-            if serial || col.len() < 2 || elements < PAR_MIN {
-                col.clone().for_each(run);
-            } else {
-                col.clone().into_par_iter().with_max_len(1).for_each(run);
+    /// Chunk `k`: `warm(nodes)` on its distinct nodes (ascending), then `body(e)` for its
+    /// elements in storage order. The warm-up is independent loads that bring the chunk's nodal
+    /// data into cache at full memory parallelism, before the element loop's gathers, which wait
+    /// on each other through the scatter (measured: about 10 % faster at 10⁶ elements, where the
+    /// nodal vectors do not fit in cache).
+    fn run_chunk(&self, k: usize, warm: &impl Fn(&[u32]), body: &impl Fn(usize)) {
+        warm(&self.chunk_nodes[self.chunk_node_start[k]..self.chunk_node_start[k + 1]]);
+        self.chunks[k].clone().for_each(body)
+    }
+}
+
+/// The order the element loop keeps on more than one thread: the chunks of the element kinds'
+/// [`Schedule`]s numbered in the one-thread order (the tets' chunks colour by colour, then the
+/// hexes'), and an edge from chunk i to chunk j > i when j is the next chunk after i to touch
+/// one of i's nodes. So the chunks that touch a node form a chain of edges in the one-thread
+/// order: two of them never run at the same time, and every node sums its elements' forces in
+/// the order of one thread (bit-identical results on any number of threads). A chunk starts as
+/// soon as its predecessors are done, not when a whole colour is: the loop is one parallel
+/// region (one fork-join a step instead of one per colour), and a thread that finishes its
+/// last chunk of a colour takes a ready chunk of the next colour instead of waiting for the
+/// other thread.
+#[derive(Clone, Debug, Default)]
+pub struct ChunkGraph {
+    /// Per chunk, its number of predecessors.
+    preds: Vec<u32>,
+    /// Chunk k's successors: `succ[succ_start[k]..succ_start[k + 1]]`, ascending.
+    succ_start: Vec<usize>,
+    succ: Vec<u32>,
+    /// The chunks without predecessors, ascending.
+    roots: Vec<u32>,
+}
+
+impl ChunkGraph {
+    /// The graph of the schedules' chunks in that order (`nodes`: the mesh's node count).
+    fn new(schedules: &[&Schedule], nodes: usize) -> ChunkGraph {
+        let total: usize = schedules.iter().map(|s| s.chunks.len()).sum();
+        let mut last = vec![u32::MAX; nodes];
+        let mut edges: Vec<(u32, u32)> = Vec::new();
+        let mut k = 0u32;
+        for s in schedules {
+            for c in 0..s.chunks.len() {
+                for &v in &s.chunk_nodes[s.chunk_node_start[c]..s.chunk_node_start[c + 1]] {
+                    let prev = std::mem::replace(&mut last[v as usize], k);
+                    if prev != u32::MAX {
+                        edges.push((prev, k));
+                    }
+                }
+                k += 1;
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        let mut preds = vec![0u32; total];
+        let mut succ_start = vec![0usize; total + 1];
+        for &(i, j) in &edges {
+            preds[j as usize] += 1;
+            succ_start[i as usize + 1] += 1;
+        }
+        for i in 0..total {
+            succ_start[i + 1] += succ_start[i];
+        }
+        let succ = edges.iter().map(|&(_, j)| j).collect();
+        let roots = (0..total as u32).filter(|&j| preds[j as usize] == 0).collect();
+        ChunkGraph { preds, succ_start, succ, roots }
+    }
+
+    /// Chunks in the graph.
+    pub fn len(&self) -> usize {
+        self.preds.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.preds.is_empty()
+    }
+
+    /// Chunk `k`'s successors, ascending.
+    pub fn successors(&self, k: usize) -> &[u32] {
+        &self.succ[self.succ_start[k]..self.succ_start[k + 1]]
+    }
+
+    /// Chunk `k`'s number of predecessors.
+    pub fn predecessors(&self, k: usize) -> u32 {
+        self.preds[k]
+    }
+
+    /// `run(k)` for every chunk `k`, each after its predecessors, on the threads of rayon's
+    /// pool: one parallel region. A chunk that completes a successor's predecessors runs it
+    /// next on its own thread (the first such; the others are spawned for any thread to take).
+    fn run_all(&self, run: &(impl Fn(usize) + Sync)) {
+        let pending: Vec<AtomicU32> = self.preds.iter().map(|&p| AtomicU32::new(p)).collect();
+        let pending = &pending[..];
+        crate::par::region();
+        rayon::scope(|s| {
+            for &r in &self.roots {
+                s.spawn(move |s| self.run_from(s, pending, run, r as usize));
+            }
+        });
+    }
+
+    /// Run chunk `k`, then the successors it makes ready (see [`ChunkGraph::run_all`]).
+    fn run_from<'s>(&'s self, s: &rayon::Scope<'s>, pending: &'s [AtomicU32], run: &'s (impl Fn(usize) + Sync), mut k: usize) {
+        loop {
+            run(k);
+            let mut next = None;
+            for &j in self.successors(k) {
+                // AcqRel: the thread that takes j sees the writes of all of j's predecessors
+                if pending[j as usize].fetch_sub(1, Ordering::AcqRel) == 1 {
+                    if let Some(other) = next.replace(j) {
+                        s.spawn(move |s| self.run_from(s, pending, run, other as usize));
+                    }
+                }
+            }
+            match next {
+                Some(j) => k = j as usize,
+                None => return,
             }
         }
     }
@@ -401,6 +500,7 @@ impl Model {
         let mut model = Model {
             mesh,
             materials,
+            chunk_graph: ChunkGraph::new(&[&tets.schedule, &hexes.schedule], n),
             tets,
             hexes,
             mass: {
@@ -635,52 +735,50 @@ impl Model {
         if f.len() < 4 * NODAL_BLOCK {
             f.fill(0.0);
         } else {
+            crate::par::region();
             f.par_chunks_mut(NODAL_BLOCK).for_each(|b| b.fill(0.0));
         }
         let fp = SharedMut(f.as_mut_ptr());
+        // u node by node: one bounds check per node gathered instead of one per component
+        let un: &[[f64; 3]] = u.as_chunks::<3>().0;
         // read u and f at the chunk's nodes (the sum only keeps the loads)
         let warm = |nodes: &[u32]| {
             let p = fp;
             let mut s = 0.0;
             for &v in nodes {
                 let i = 3 * v as usize;
-                // SAFETY: a read of an entry that only this chunk writes in this colour (below).
+                // SAFETY: a read of an entry that no other chunk writes while this one runs (below).
                 s += u[i] + unsafe { *p.0.add(i) };
             }
             std::hint::black_box(s);
         };
-        self.tets.schedule.for_each_element(warm, |e| {
+        let tet = |e: usize| {
             if (SKIP_MASSLESS && self.massless_cells[self.tets.cell[e] as usize]) || other_pair(self.tets.mat[e]) {
                 return;
             }
             let nd = &self.tets.nodes[e];
-            let ue: [[f64; 3]; 4] = std::array::from_fn(|a| {
-                let i = 3 * nd[a] as usize;
-                [u[i], u[i + 1], u[i + 2]]
-            });
+            let ue: [[f64; 3]; 4] = std::array::from_fn(|a| un[nd[a] as usize]);
             let g = &self.tets.geom[e];
             let fe = tet4::internal_forces(&g.grad, g.vol, &ue, &self.materials[self.tets.mat[e] as usize].lame);
             let p = fp;
             for a in 0..4 {
                 let i = 3 * nd[a] as usize;
-                // SAFETY: the chunks assembled concurrently are of one colour and share no node
-                // (module invariant); within a chunk the elements run in order on one thread.
+                // SAFETY: the chunks assembled concurrently share no node ([`ChunkGraph`]: the
+                // chunks that touch a node run one after the other); within a chunk the
+                // elements run in order on one thread.
                 unsafe {
                     *p.0.add(i) += fe[a][0];
                     *p.0.add(i + 1) += fe[a][1];
                     *p.0.add(i + 2) += fe[a][2];
                 }
             }
-        });
-        self.hexes.schedule.for_each_element(warm, |e| {
+        };
+        let hex = |e: usize| {
             if (SKIP_MASSLESS && self.massless_cells[self.hexes.cell[e] as usize]) || other_pair(self.hexes.mat[e]) {
                 return;
             }
             let nd = &self.hexes.nodes[e];
-            let ue: [[f64; 3]; 8] = std::array::from_fn(|a| {
-                let i = 3 * nd[a] as usize;
-                [u[i], u[i + 1], u[i + 2]]
-            });
+            let ue: [[f64; 3]; 8] = std::array::from_fn(|a| un[nd[a] as usize]);
             let s = &self.hexes.shapes[self.hexes.shape[e] as usize];
             let fe = hex8::internal_forces(s, &ue, &self.materials[self.hexes.mat[e] as usize].lame);
             let p = fp;
@@ -693,7 +791,23 @@ impl Model {
                     *p.0.add(i + 2) += fe[a][2];
                 }
             }
-        });
+        };
+        // the chunks in the graph's numbering: the tets', then the hexes'
+        let nt = self.tets.schedule.chunks.len();
+        let run = |k: usize| {
+            if k < nt {
+                self.tets.schedule.run_chunk(k, &warm, &tet)
+            } else {
+                self.hexes.schedule.run_chunk(k - nt, &warm, &hex)
+            }
+        };
+        // one thread: the chunks in order, no pool hand-off (on a 10⁴-element model with
+        // contact a hand-off per colour cost about as much as the elements themselves)
+        if rayon::current_num_threads() == 1 || self.n_elements() < PAR_MIN {
+            (0..self.chunk_graph.len()).for_each(run);
+        } else {
+            self.chunk_graph.run_all(&run);
+        }
     }
 
     /// Element stresses (xx, yy, zz, xy, yz, zx) [Pa] in model element order (tets, then hexes).
@@ -942,7 +1056,8 @@ impl ElementScan {
         drop((to, tm, tc));
         let (hn, hs, hm, hc) = (std::mem::take(&mut self.hn), std::mem::take(&mut self.hs), std::mem::take(&mut self.hm), std::mem::take(&mut self.hc));
         let (ho, hsched) = assembly_order(&hn, &mesh.nodes)?;
-        let hexes = Hex8Set { nodes: permute(&hn, &ho), shape: permute(&hs, &ho), mat: permute(&hm, &ho), cell: permute(&hc, &ho), schedule: hsched, shapes: std::mem::take(&mut self.shapes) };
+        let (shape, shapes) = shapes_in_use_order(&permute(&hs, &ho), std::mem::take(&mut self.shapes));
+        let hexes = Hex8Set { nodes: permute(&hn, &ho), shape, mat: permute(&hm, &ho), cell: permute(&hc, &ho), schedule: hsched, shapes };
         Ok((tets, hexes))
     }
 
@@ -954,6 +1069,28 @@ impl ElementScan {
         }
         self.active[node] = true;
     }
+}
+
+/// The hex8 shapes renumbered in the order the element loop first uses them (`shape`: each
+/// element's shape, in assembly order): the loop then streams the shapes in storage order. On a
+/// curved mesh, where every element has its own shape (1.6 kB each), the scan's numbering (mesh
+/// cell order) made the loop fetch them out of order. The same values: results unchanged.
+fn shapes_in_use_order(shape: &[u32], shapes: Vec<HexShape>) -> (Vec<u32>, Vec<HexShape>) {
+    let mut new_id = vec![u32::MAX; shapes.len()];
+    let mut order: Vec<u32> = Vec::with_capacity(shapes.len());
+    let renumbered = shape
+        .iter()
+        .map(|&id| {
+            if new_id[id as usize] == u32::MAX {
+                new_id[id as usize] = order.len() as u32;
+                order.push(id);
+            }
+            new_id[id as usize]
+        })
+        .collect();
+    let mut slots: Vec<Option<HexShape>> = shapes.into_iter().map(Some).collect();
+    let reordered = order.iter().filter_map(|&id| slots[id as usize].take()).collect();
+    (renumbered, reordered)
 }
 
 /// The corner points of a tet4 with mesh nodes `nodes`.

@@ -219,6 +219,7 @@ impl Condensation {
             faer::linalg::matmul::matmul(yv, Accum::Replace, s.subcols(r0, len).transpose(), ub, 1.0, Par::Seq);
         };
         if self.sub.len() >= 4 * SCHUR_ROWS {
+            crate::par::region();
             self.sub.par_chunks_mut(SCHUR_ROWS).enumerate().for_each(rows);
         } else {
             self.sub.chunks_mut(SCHUR_ROWS).enumerate().for_each(rows);
