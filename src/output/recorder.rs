@@ -468,7 +468,8 @@ impl Recorder {
         }
         for (steps, residual, tolerance, names) in gs {
             let who = if names.len() == 1 { format!("joint {}", names[0]) } else { format!("joints {} ({} joints, swept together)", names.join(", "), names.len()) };
-            let worst = worst_cap.map(|c| format!("; {}", c.describe(&joint_names))).unwrap_or_default();
+            let laws: Vec<&crate::contact::law::JointLaw> = sim.problem.joints.iter().map(|j| &j.law).collect();
+            let worst = worst_cap.map(|c| format!("; {}{}", c.describe(&joint_names), cone_cycle_hint(c, &laws))).unwrap_or_default();
             w.push(format!(
                 "{who}: Gauss–Seidel stopped at gs_max_sweeps in {steps} steps with a residual up to {residual:.2e} m, {:.0} × its tolerance {tolerance:.1e} m (above {GS_WARN_FACTOR}×): the contact forces of those steps are not converged (cap: ContactSolver::gs_max_sweeps, 200 sweeps){worst}",
                 residual / tolerance
@@ -621,5 +622,48 @@ impl Observer for Recorder {
             jw.envelope.write(&self.out_dir)?;
         }
         Ok(())
+    }
+}
+
+/// The cure to name when a Gauss–Seidel cap's worst node has pairs on two joints or more whose
+/// laws are the seed's truncated Mohr–Coulomb cone with cohesion (no tensile strength, no
+/// asperity envelope): a closed pair at r_n → 0 still carries c A and an open one nothing, so
+/// the node's pairs can have no consistent state (docs/contact.md, "The bilinear envelope");
+/// empty otherwise.
+pub fn cone_cycle_hint(cap: &crate::contact::state::CapStep, laws: &[&crate::contact::law::JointLaw]) -> String {
+    let mut joints: Vec<usize> = cap.pairs.iter().map(|p| p.0).collect();
+    joints.sort_unstable();
+    joints.dedup();
+    let cone = |j: &usize| laws.get(*j).is_some_and(|l| !l.tied && l.cohesion > 0.0 && l.tensile_strength == 0.0 && l.asperity_friction.is_none());
+    if joints.len() >= 2 && joints.iter().all(cone) {
+        "; under the truncated Mohr–Coulomb cone (cohesion, no tensile strength) a closed pair at zero normal force still carries c A and an open one nothing, so such a node can have no consistent state: the opt-in bilinear envelope joints[].asperity_angle converges there (docs/contact.md, \"The bilinear envelope\"), as a different law".into()
+    } else {
+        String::new()
+    }
+}
+
+#[cfg(test)]
+mod cone_hint_tests {
+    use super::cone_cycle_hint;
+    use crate::contact::law::{JointLaw, PairState};
+    use crate::contact::state::CapStep;
+
+    /// The Gauss–Seidel warning names the bilinear envelope exactly when the capped node is shared
+    /// by joints that all carry the seed's cohesive cone (the demo wedge's joints A and B: c 24 and
+    /// 48 kPa, no tensile strength), and not for one joint, a tensile bond or an envelope.
+    #[test]
+    fn gs_cap_warning_names_the_envelope_only_for_a_node_shared_by_cohesive_cone_joints() {
+        let cone = |c: f64| JointLaw { cohesion: c, keep_cohesion: true, ..JointLaw::coulomb(0.36) };
+        let (a, b) = (cone(24e3), cone(48e3));
+        let shared = CapStep { t: 24.39, node: 18, residual: 1.03e-6, pairs: vec![(0, 18, PairState::Slip), (1, 18, PairState::Open)] };
+        assert!(cone_cycle_hint(&shared, &[&a, &b]).contains("asperity_angle"));
+        let single = CapStep { pairs: vec![(1, 18, PairState::Slip)], ..shared.clone() };
+        assert!(cone_cycle_hint(&single, &[&a, &b]).is_empty());
+        let bonded = JointLaw { tensile_strength: 1e5, ..b };
+        assert!(cone_cycle_hint(&shared, &[&a, &bonded]).is_empty());
+        let envelope = JointLaw { asperity_friction: Some(1.0), ..b };
+        assert!(cone_cycle_hint(&shared, &[&a, &envelope]).is_empty());
+        let frictional = JointLaw::coulomb(0.36);
+        assert!(cone_cycle_hint(&shared, &[&a, &frictional]).is_empty());
     }
 }
