@@ -331,20 +331,14 @@ fn static_scene(size: &str) -> (std::path::PathBuf, serde_json::Value) {
 /// symbolic analyses only (no numeric factorisation, so a mesh whose factor would not fit can
 /// be measured), per mesh of `JQ_DAM_FILL` (comma list as `JQ_DAM_STATIC`; unset skips it):
 /// stage a's K̂ and stage c's preconditioner P (`statics::contact::static_matrices`), each
-/// with its unknowns, factor entries (MB at 8 B each), flops of one factorisation and the
+/// with its unknowns, factor entries (MB at 8 B each, and at 4 B: the f32 factor stage c uses
+/// from `statics::contact::SINGLE_FROM` unknowns), flops of one factorisation and the
 /// analysis's seconds, and the process's peak RSS after the mesh.
 fn static_fill() -> Vec<serde_json::Value> {
     use jointquake::linalg::{analyse, FillOrdering};
-    let sizes = std::env::var("JQ_DAM_FILL").unwrap_or_default();
     let mut rows = Vec::new();
-    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let (path, _) = static_scene(size);
-        let cache = root().join("target/bench-mesh");
-        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
-            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
-            jointquake::problem::Problem::build(s, mesh).map_err(|e| e.to_string())
-        });
-        let (k0, p) = match problem.map_err(|e| e.to_string()).and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
+    for (size, _, problem) in static_problems("JQ_DAM_FILL") {
+        let (k0, p) = match problem.and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
             Ok(m) => m,
             Err(e) => {
                 println!("fill, {size}: skipped ({e})");
@@ -356,8 +350,8 @@ fn static_fill() -> Vec<serde_json::Value> {
                 match analyse(m, stage, ordering) {
                     Ok(a) => {
                         let (_, peak_mb) = cpu_and_peak();
-                        println!("fill, {size}, stage {stage}: {ordering:?}: {} unknowns, {} entries, factor {:.0} MB, {:.3e} flops, analysis {:.1} s (peak RSS so far {peak_mb:.0} MB)", a.n, m.nnz(), a.factor_entries as f64 * 8e-6, a.factor_flops, a.seconds);
-                        rows.push(serde_json::json!({"mesh": size, "stage": stage, "ordering": format!("{ordering:?}"), "n": a.n, "entries": m.nnz(), "factor_mb": a.factor_entries as f64 * 8e-6, "factor_flops": a.factor_flops, "analysis_s": a.seconds}));
+                        println!("fill, {size}, stage {stage}: {ordering:?}: {} unknowns, {} entries, factor {:.0} MB (in f32 {:.0} MB), {:.3e} flops, analysis {:.1} s (peak RSS so far {peak_mb:.0} MB)", a.n, m.nnz(), a.factor_entries as f64 * 8e-6, a.factor_entries as f64 * 4e-6, a.factor_flops, a.seconds);
+                        rows.push(serde_json::json!({"mesh": size, "stage": stage, "ordering": format!("{ordering:?}"), "n": a.n, "entries": m.nnz(), "factor_mb": a.factor_entries as f64 * 8e-6, "factor_mb_f32": a.factor_entries as f64 * 4e-6, "factor_flops": a.factor_flops, "analysis_s": a.seconds}));
                     }
                     Err(e) => println!("fill, {size}, stage {stage}: {ordering:?}: {e}"),
                 }
@@ -377,16 +371,9 @@ fn static_fill() -> Vec<serde_json::Value> {
 /// difference from the one-thread factor's, relative to its largest entry.
 fn static_factor() -> Vec<serde_json::Value> {
     use jointquake::linalg::{FillOrdering, SparseCholesky};
-    let sizes = std::env::var("JQ_DAM_FACTOR").unwrap_or_default();
     let repeats: usize = std::env::var("JQ_FACTOR_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(2usize).max(1);
     let mut rows = Vec::new();
-    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let (path, _) = static_scene(size);
-        let cache = root().join("target/bench-mesh");
-        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
-            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
-            jointquake::problem::Problem::build(s, mesh).map_err(|e| e.to_string())
-        });
+    for (size, _, problem) in static_problems("JQ_DAM_FACTOR") {
         let p = match problem.and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
             Ok((_, p)) => p,
             Err(e) => {
@@ -576,24 +563,25 @@ fn cpu_and_peak() -> (f64, f64) {
 /// hr 40, hrf 200; fine: h 5, ht 1.25, hr 12.5, hrf 80; h2.5: h 2.5, ht 0.625, hr 6.25, hrf 40),
 /// meshed into target/bench-mesh, solved by `pipeline::run_inspect` with duration 0 (outputs in
 /// target/bench-static). Prints per mesh the wall and CPU time of the run (meshing excluded:
-/// the mesh is made first), the stages' notes (stage a: unknowns, assembly and Cholesky time,
+/// the mesh is made, and a model built and dropped, first: `static_problems`), the stages' notes (stage a: unknowns, assembly and Cholesky time,
 /// factor size; stage c: Newton iterations, factorisations, GMRES products, their times), and
 /// the process's peak RSS so far (sizes in the order given, so list them smallest first: the
 /// peak is then the last mesh's). Goals: fine ≤ 120 s and ≤ 3 GB, h2.5 ≤ 15 min and ≤ 16 GB.
 fn static_state() -> Vec<serde_json::Value> {
-    let sizes = std::env::var("JQ_DAM_STATIC").unwrap_or_default();
     let mut rows = Vec::new();
-    for size in sizes.split(',').map(str::trim).filter(|s| !s.is_empty()) {
-        let (path, scene) = static_scene(size);
-        let cache = root().join("target/bench-mesh");
-        let t_mesh = Instant::now();
-        let loaded = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|s| jointquake::pipeline::load_mesh(&s, Some(&cache)).map_err(|e| e.to_string()));
-        if let Err(e) = loaded {
+    let mut t_mesh = Instant::now();
+    for (size, path, problem) in static_problems("JQ_DAM_STATIC") {
+        // the mesh is made (and the model built, then dropped) before the timed run
+        if let Err(e) = problem {
             println!("static state, {size}: skipped ({e})");
+            t_mesh = Instant::now();
             continue;
         }
+        drop(problem);
         let mesh_s = t_mesh.elapsed().as_secs_f64();
-        let opts = jointquake::pipeline::RunOptions { out_dir: Some(root().join("target/bench-static").join(size)), mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
+        let scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("the bench scene")).expect("the bench scene is JSON");
+        let cache = root().join("target/bench-mesh");
+        let opts = jointquake::pipeline::RunOptions { out_dir: Some(root().join("target/bench-static").join(&size)), mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
         let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
         let (cpu0, _) = cpu_and_peak();
         let t0 = Instant::now();
@@ -603,7 +591,7 @@ fn static_state() -> Vec<serde_json::Value> {
         match summary {
             Ok(s) => {
                 let stages: Vec<&String> = s.notes.iter().filter(|n| n.starts_with("static sequence")).collect();
-                println!("static state, {size} (load average {load}): {wall:.1} s wall, {:.1} s CPU, peak RSS {peak_mb:.0} MB (meshing {mesh_s:.1} s before)", cpu1 - cpu0);
+                println!("static state, {size} (load average {load}): {wall:.1} s wall, {:.1} s CPU, peak RSS {peak_mb:.0} MB (mesh and model {mesh_s:.1} s before)", cpu1 - cpu0);
                 for n in &stages {
                     println!("    {n}");
                 }
@@ -611,6 +599,7 @@ fn static_state() -> Vec<serde_json::Value> {
             }
             Err(e) => println!("static state, {size}: failed after {wall:.1} s ({e})"),
         }
+        t_mesh = Instant::now();
     }
     rows
 }
@@ -665,4 +654,21 @@ fn element_schedule_bounds(model: &jointquake::model::Model, skip_massless: bool
         }
     }
     (total / barrier, total / now)
+}
+
+/// The meshes of the env list `var` (comma list of coarse, default, fine, h2.5; unset or empty:
+/// none), one after the other: each mesh's name, its bench scene (`static_scene`) and the
+/// model on the mesh loaded from target/bench-mesh (meshed there first if missing), or why
+/// not. Lazy, so that one model is in memory at a time.
+fn static_problems(var: &str) -> impl Iterator<Item = (String, PathBuf, Result<Problem, String>)> {
+    let sizes: Vec<String> = std::env::var(var).unwrap_or_default().split(',').map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect();
+    sizes.into_iter().map(|size| {
+        let (path, _) = static_scene(&size);
+        let cache = root().join("target/bench-mesh");
+        let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
+            let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
+            Problem::build(s, mesh).map_err(|e| e.to_string())
+        });
+        (size, path, problem)
+    })
 }

@@ -19,10 +19,28 @@ use faer::{Conj, MatMut, Par, Side};
 /// 0.116 s on one, and no less wall time.
 pub const SOLVE_PAR: Par = Par::Seq;
 
+/// The scalar a factor's values are computed and stored in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum FactorPrecision {
+    /// f64 (8 B an entry): a direct solve to the matrix's round-off.
+    Double,
+    /// f32 (4 B an entry): half the memory and the bandwidth of the solves; a solve is exact
+    /// only to f32's round-off times the condition number, so only for a preconditioner (the
+    /// right-hand side is rounded to f32 and the solution widened back to f64).
+    Single,
+}
+
+/// A factor's values in their precision; for f32 also the matrix's values and a right-hand
+/// side rounded to f32.
+enum Values {
+    Double(Vec<f64>),
+    Single { l: Vec<f32>, a: Vec<f32>, x: Vec<f32> },
+}
+
 /// A factorised symmetric positive definite matrix.
 pub struct SparseCholesky {
     symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+    values: Values,
     /// Scratch of one solve with `scratch_cols` right-hand sides.
     scratch: MemBuffer,
     scratch_cols: usize,
@@ -43,7 +61,7 @@ pub struct SparseCholesky {
 
 impl std::fmt::Debug for SparseCholesky {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SparseCholesky {{ n: {}, factor entries: {} }}", self.n(), self.values.len())
+        write!(f, "SparseCholesky {{ n: {}, factor entries: {}, {:?} }}", self.n(), self.factor_entries(), self.precision())
     }
 }
 
@@ -59,22 +77,47 @@ impl SparseCholesky {
 
     /// [`SparseCholesky::factor`] with the fill-reducing ordering `ordering`.
     pub fn factor_ordered(a: &Csc, what: &str, par: Par, ordering: FillOrdering) -> Result<SparseCholesky, LinalgError> {
+        SparseCholesky::factor_in(a, what, par, ordering, FactorPrecision::Double)
+    }
+
+    /// [`SparseCholesky::factor_ordered`] with the factor's values in `precision`. In f32 a
+    /// matrix whose condition number is near 1/f32's round-off (1e7) may lose a pivot: the
+    /// error is then [`LinalgError::NotPositiveDefinite`], as for a singular matrix (a caller
+    /// that has an f64 fallback uses it).
+    pub fn factor_in(a: &Csc, what: &str, par: Par, ordering: FillOrdering, precision: FactorPrecision) -> Result<SparseCholesky, LinalgError> {
         let n = a.n_rows;
         if a.n_cols != n {
             return Err(LinalgError::Invalid(format!("{what}: a {n}×{} matrix is not square", a.n_cols)));
         }
-        let oom = || LinalgError::OutOfMemory { what: what.to_string(), n };
         let start = std::time::Instant::now();
         let ordering = ordering.resolve(n);
         let symbolic = symbolic_analysis(a, what, ordering)?;
         let analysis_seconds = start.elapsed().as_secs_f64();
-        let mut values = Vec::new();
-        values.try_reserve_exact(symbolic.len_val()).map_err(|_| oom())?;
-        values.resize(symbolic.len_val(), 0.0);
-        let scratch = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, SOLVE_PAR)).map_err(|_| oom())?;
-        let mut chol = SparseCholesky { symbolic, values, scratch, scratch_cols: 1, par, pattern_nnz: a.nnz(), ordering, analysis_seconds, split: None, permuted: Vec::new() };
-        chol.refactor(a, what)?;
+        let mut chol = SparseCholesky { symbolic, values: Values::Double(Vec::new()), scratch: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY), scratch_cols: 1, par, pattern_nnz: a.nnz(), ordering, analysis_seconds, split: None, permuted: Vec::new() };
+        chol.refactor_in(a, what, precision)?;
         Ok(chol)
+    }
+
+    /// [`SparseCholesky::refactor`] with the factor's values in `precision` from now on (the
+    /// analysis is kept; e.g. f64 after an f32 factorisation lost a pivot).
+    pub fn refactor_in(&mut self, a: &Csc, what: &str, precision: FactorPrecision) -> Result<(), LinalgError> {
+        let (n, len) = (self.n(), self.symbolic.len_val());
+        let oom = || LinalgError::OutOfMemory { what: what.to_string(), n };
+        if self.precision() != precision || self.factor_entries() != len {
+            // the old values go first: the two factors need not fit at once
+            self.values = Values::Double(Vec::new());
+            let (values, scratch) = match precision {
+                FactorPrecision::Double => (Values::Double(zeros(len).ok_or_else(oom)?), self.symbolic.solve_in_place_scratch::<f64>(1, SOLVE_PAR)),
+                FactorPrecision::Single => {
+                    let values = Values::Single { l: zeros(len).ok_or_else(oom)?, a: zeros(self.pattern_nnz).ok_or_else(oom)?, x: zeros(n).ok_or_else(oom)? };
+                    (values, self.symbolic.solve_in_place_scratch::<f32>(1, SOLVE_PAR))
+                }
+            };
+            self.values = values;
+            self.scratch = MemBuffer::try_new(scratch).map_err(|_| oom())?;
+            self.scratch_cols = 1;
+        }
+        self.refactor(a, what)
     }
 
     /// Factorise `a` again, a matrix with the pattern of the one this was made for (the
@@ -85,10 +128,21 @@ impl SparseCholesky {
         if a.n_rows != n || a.n_cols != n || a.nnz() != self.pattern_nnz {
             return Err(LinalgError::Invalid(format!("{what}: refactorising a {}×{} matrix with {} entries on the analysis of a {n}×{n} one with {}", a.n_rows, a.n_cols, a.nnz(), self.pattern_nnz)));
         }
-        let mut stack = MemBuffer::try_new(self.symbolic.factorize_numeric_llt_scratch::<f64>(self.par, Default::default())).map_err(|_| LinalgError::OutOfMemory { what: what.to_string(), n })?;
-        let res = self.symbolic.factorize_numeric_llt::<f64>(&mut self.values, a.as_faer(), Side::Lower, Default::default(), self.par, MemStack::new(&mut stack), Default::default());
+        let oom = || LinalgError::OutOfMemory { what: what.to_string(), n };
+        let res = match &mut self.values {
+            Values::Double(l) => {
+                let mut stack = MemBuffer::try_new(self.symbolic.factorize_numeric_llt_scratch::<f64>(self.par, Default::default())).map_err(|_| oom())?;
+                self.symbolic.factorize_numeric_llt::<f64>(l, a.as_faer(), Side::Lower, Default::default(), self.par, MemStack::new(&mut stack), Default::default()).map(|_| ())
+            }
+            Values::Single { l, a: a32, .. } => {
+                a32.iter_mut().zip(&a.val).for_each(|(s, &v)| *s = v as f32);
+                let m = faer::sparse::SparseColMatRef::new(a.as_faer().symbolic(), &a32[..]);
+                let mut stack = MemBuffer::try_new(self.symbolic.factorize_numeric_llt_scratch::<f32>(self.par, Default::default())).map_err(|_| oom())?;
+                self.symbolic.factorize_numeric_llt::<f32>(l, m, Side::Lower, Default::default(), self.par, MemStack::new(&mut stack), Default::default()).map(|_| ())
+            }
+        };
         match res {
-            Ok(_) => Ok(()),
+            Ok(()) => Ok(()),
             Err(NumericLltError::NonPositivePivot { index }) => Err(LinalgError::NotPositiveDefinite { what: what.to_string(), pivot: index, n }),
         }
     }
@@ -98,9 +152,28 @@ impl SparseCholesky {
         self.symbolic.nrows()
     }
 
-    /// Entries of the factor L (its memory is 8 B each).
+    /// Entries of the factor L (8 B each in f64, 4 B in f32: [`Self::factor_bytes`]).
     pub fn factor_entries(&self) -> usize {
-        self.values.len()
+        match &self.values {
+            Values::Double(l) => l.len(),
+            Values::Single { l, .. } => l.len(),
+        }
+    }
+
+    /// Bytes of the factor's values.
+    pub fn factor_bytes(&self) -> usize {
+        match &self.values {
+            Values::Double(l) => 8 * l.len(),
+            Values::Single { l, .. } => 4 * l.len(),
+        }
+    }
+
+    /// The precision of the factor's values.
+    pub fn precision(&self) -> FactorPrecision {
+        match &self.values {
+            Values::Double(_) => FactorPrecision::Double,
+            Values::Single { .. } => FactorPrecision::Single,
+        }
     }
 
     /// The fill-reducing ordering of the analysis (AMD or nested dissection).
@@ -145,7 +218,14 @@ impl SparseCholesky {
                 Some(perm) => perm.arrays().0.iter().zip(xp.iter_mut()).for_each(|(&old, v)| *v = x[old]),
                 None => xp.copy_from_slice(x),
             }
-            split.solve_permuted(sn, &self.values, xp);
+            match &mut self.values {
+                Values::Double(l) => split.solve_permuted(sn, l, xp),
+                Values::Single { l, x: x32, .. } => {
+                    x32.iter_mut().zip(xp.iter()).for_each(|(s, &v)| *s = v as f32);
+                    split.solve_permuted(sn, l, x32);
+                    xp.iter_mut().zip(x32.iter()).for_each(|(v, &s)| *v = s as f64);
+                }
+            }
             match self.symbolic.perm() {
                 Some(perm) => perm.arrays().0.iter().zip(xp.iter()).for_each(|(&old, v)| x[old] = *v),
                 None => x.copy_from_slice(xp),
@@ -159,19 +239,51 @@ impl SparseCholesky {
     /// X ← A⁻¹ X for a column-major block of right-hand sides.
     pub fn solve_mat_in_place(&mut self, rhs: MatMut<'_, f64>) {
         if rhs.ncols() > self.scratch_cols {
-            self.scratch = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), SOLVE_PAR));
+            self.scratch = MemBuffer::new(match self.values {
+                Values::Double(_) => self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), SOLVE_PAR),
+                Values::Single { .. } => self.symbolic.solve_in_place_scratch::<f32>(rhs.ncols(), SOLVE_PAR),
+            });
             self.scratch_cols = rhs.ncols();
         }
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, SOLVE_PAR, MemStack::new(&mut self.scratch));
+        solve_with(&self.symbolic, &self.values, rhs, SOLVE_PAR, MemStack::new(&mut self.scratch));
     }
 
     /// X ← A⁻¹ X with a scratch of its own (one thread): for blocks of right-hand sides solved
     /// in parallel on a shared factorisation.
     pub fn solve_block_in_place(&self, rhs: MatMut<'_, f64>) -> Result<(), LinalgError> {
         let n = self.n();
-        let mut scratch = MemBuffer::try_new(self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), Par::Seq)).map_err(|_| LinalgError::OutOfMemory { what: "solve scratch".into(), n })?;
-        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut scratch));
+        let bytes = match self.values {
+            Values::Double(_) => self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), Par::Seq),
+            Values::Single { .. } => self.symbolic.solve_in_place_scratch::<f32>(rhs.ncols(), Par::Seq),
+        };
+        let mut scratch = MemBuffer::try_new(bytes).map_err(|_| LinalgError::OutOfMemory { what: "solve scratch".into(), n })?;
+        solve_with(&self.symbolic, &self.values, rhs, Par::Seq, MemStack::new(&mut scratch));
         Ok(())
+    }
+}
+
+/// A vector of `len` zeros, or `None` if the memory cannot be had.
+fn zeros<T: Clone + Default>(len: usize) -> Option<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).ok()?;
+    v.resize(len, T::default());
+    Some(v)
+}
+
+/// X ← A⁻¹ X with faer's solve on the factor `values` of `symbolic` (an f32 factor on a copy of X
+/// rounded to f32, widened back).
+fn solve_with(symbolic: &SymbolicCholesky<usize>, values: &Values, mut rhs: MatMut<'_, f64>, par: Par, stack: &mut MemStack) {
+    match values {
+        Values::Double(l) => LltRef::new(symbolic, l).solve_in_place_with_conj(Conj::No, rhs, par, stack),
+        Values::Single { l, .. } => {
+            let mut x32 = faer::Mat::<f32>::from_fn(rhs.nrows(), rhs.ncols(), |i, j| rhs[(i, j)] as f32);
+            LltRef::new(symbolic, l).solve_in_place_with_conj(Conj::No, x32.as_mut(), par, stack);
+            for j in 0..rhs.ncols() {
+                for i in 0..rhs.nrows() {
+                    rhs[(i, j)] = x32[(i, j)] as f64;
+                }
+            }
+        }
     }
 }
 
@@ -237,15 +349,27 @@ mod tests {
     use super::*;
     use crate::linalg::assemble::{dof_map, restrict, stiffness};
 
+    /// K_ff of the box (`assemble::tests::box_model`, tetrahedra, `dims` divisions) clamped
+    /// on its x0 face: the stiffness on its free dofs.
+    fn clamped_box_kff(dims: [usize; 3]) -> Csc {
+        let m = crate::linalg::assemble::tests::box_model(true, dims);
+        let k = stiffness(&m, &[true]);
+        let (map, nf) = dof_map(3 * m.n_nodes(), |d| m.is_free(d / 3, d % 3));
+        restrict(&k, &map, nf, &map, nf)
+    }
+
+    /// The largest |a − b| relative to the largest |a|.
+    fn rel_diff<T: Into<f64> + Copy>(a: &[T], b: &[T]) -> f64 {
+        let scale = a.iter().fold(0.0f64, |m, &v| m.max(v.into().abs()));
+        a.iter().zip(b).map(|(&x, &y)| (x.into() - y.into()).abs()).fold(0.0, f64::max) / scale
+    }
+
     #[test]
     fn cholesky_solves_the_supported_box() {
         // K_ff x = b on the free dofs of a clamped box; residual ‖K x − b‖ ≤ 1e-10 ‖b‖
         // (a direct solve: only round-off, the condition number here is about 1e4)
-        let m = crate::linalg::assemble::tests::box_model(true, [4, 2, 2]);
-        let k = stiffness(&m, &[true]);
-        let n = 3 * m.n_nodes();
-        let (map, nf) = dof_map(n, |d| m.is_free(d / 3, d % 3));
-        let kff = restrict(&k, &map, nf, &map, nf);
+        let kff = clamped_box_kff([4, 2, 2]);
+        let nf = kff.n_rows;
         let mut ch = SparseCholesky::factor(&kff, "test", Par::Seq).unwrap();
         let b: Vec<f64> = (0..nf).map(|i| (i as f64 * 0.37).sin()).collect();
         let mut x = b.clone();
@@ -260,12 +384,9 @@ mod tests {
     #[test]
     fn refactorisation_reuses_the_analysis_and_checks_the_pattern() {
         // K x = b, then 2 K refactorised on the same analysis: x/2 to round-off (1e-12
-        // relative); a matrix of another pattern is refused, not factorised wrongly
-        let m = crate::linalg::assemble::tests::box_model(true, [3, 2, 2]);
-        let k = stiffness(&m, &[true]);
-        let n = 3 * m.n_nodes();
-        let (map, nf) = dof_map(n, |d| m.is_free(d / 3, d % 3));
-        let mut kff = restrict(&k, &map, nf, &map, nf);
+        // relative); a matrix of another pattern (another box) is refused, not factorised wrongly
+        let mut kff = clamped_box_kff([3, 2, 2]);
+        let nf = kff.n_rows;
         let mut ch = SparseCholesky::factor(&kff, "test", Par::Seq).unwrap();
         let b: Vec<f64> = (0..nf).map(|i| (i as f64 * 0.11).cos()).collect();
         let mut x1 = b.clone();
@@ -276,8 +397,7 @@ mod tests {
         ch.solve_in_place(&mut x2);
         let scale = x1.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         assert!(x1.iter().zip(&x2).all(|(a, b)| (a - 2.0 * b).abs() < 1e-12 * scale));
-        let (map2, nf2) = dof_map(n, |d| m.is_free(d / 3, d % 3) && d != 3 * m.n_nodes() - 1);
-        let other = restrict(&k, &map2, nf2, &map2, nf2);
+        let other = clamped_box_kff([3, 2, 3]);
         assert!(matches!(ch.refactor(&other, "other"), Err(LinalgError::Invalid(_))));
     }
 
@@ -286,11 +406,8 @@ mod tests {
         // the clamped 8×6×6 box's K_ff x = b with both orderings: the same x to 1e-10 relative
         // (direct solves, only round-off differs), residual ≤ 1e-10 ‖b‖; the factor's flop
         // count is positive and its solve scratch works for a block of right-hand sides too
-        let m = crate::linalg::assemble::tests::box_model(true, [8, 6, 6]);
-        let k = stiffness(&m, &[true]);
-        let n = 3 * m.n_nodes();
-        let (map, nf) = dof_map(n, |d| m.is_free(d / 3, d % 3));
-        let kff = restrict(&k, &map, nf, &map, nf);
+        let kff = clamped_box_kff([8, 6, 6]);
+        let nf = kff.n_rows;
         let mut amd = SparseCholesky::factor_ordered(&kff, "box", Par::Seq, FillOrdering::Amd).unwrap();
         let mut nd = SparseCholesky::factor_ordered(&kff, "box", Par::Seq, FillOrdering::NestedDissection).unwrap();
         assert_eq!(nd.ordering(), FillOrdering::NestedDissection);
@@ -316,11 +433,8 @@ mod tests {
         // split over the elimination tree (linalg::tree_solve) against faer's sequential one,
         // equal to round-off (1e-12 of the largest entry: the same operations, the top's
         // updates summed in another order), and bit-identical in pools of 1 and 2 threads
-        let m = crate::linalg::assemble::tests::box_model(true, [10, 8, 8]);
-        let k = stiffness(&m, &[true]);
-        let n = 3 * m.n_nodes();
-        let (map, nf) = dof_map(n, |d| m.is_free(d / 3, d % 3));
-        let kff = restrict(&k, &map, nf, &map, nf);
+        let kff = clamped_box_kff([10, 8, 8]);
+        let nf = kff.n_rows;
         let mut ch = SparseCholesky::factor_ordered(&kff, "box", Par::Seq, FillOrdering::NestedDissection).unwrap();
         let b: Vec<f64> = (0..nf).map(|i| (i as f64 * 0.31).sin()).collect();
         let mut reference = b.clone();
@@ -339,6 +453,41 @@ mod tests {
         let scale = reference.iter().fold(0.0f64, |a, v| a.max(v.abs()));
         let d = reference.iter().zip(&x1).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         assert!(d < 1e-12 * scale, "{d} vs {scale}");
+    }
+
+    #[test]
+    fn single_precision_factor_solves_to_f32_round_off_and_switches_back() {
+        // the clamped 10×8×8 box's K_ff (condition number about 1e4) factorised in f32 under
+        // nested dissection: 4 bytes an entry, half the f64 factor's; its solution equals the f64
+        // one to 1e-3 of the largest entry (f32's round-off 6e-8 × the condition number; measured 9e-6; a
+        // preconditioner needs no more); the split solve equals faer's f32 solve to 1e-5 (f32
+        // round-off, sums in another order); refactorised in f64 on the same analysis it is
+        // the f64 factor again (to 1e-12)
+        let kff = clamped_box_kff([10, 8, 8]);
+        let b: Vec<f64> = (0..kff.n_rows).map(|i| (i as f64 * 0.23).cos()).collect();
+        let solve = |ch: &mut SparseCholesky| {
+            let mut x = b.clone();
+            ch.solve_in_place(&mut x);
+            x
+        };
+        let mut double = SparseCholesky::factor_ordered(&kff, "box", Par::Seq, FillOrdering::NestedDissection).unwrap();
+        let mut single = SparseCholesky::factor_in(&kff, "box", Par::Seq, FillOrdering::NestedDissection, FactorPrecision::Single).unwrap();
+        assert_eq!(single.precision(), FactorPrecision::Single);
+        assert_eq!(single.factor_bytes(), 4 * single.factor_entries());
+        let (x64, x32) = (solve(&mut double), solve(&mut single));
+        let d = rel_diff(&x64, &x32);
+        println!("f32 factor vs f64: {d:.2e}");
+        assert!(d < 1e-3 && d > 0.0, "{d:.2e}");
+        single.split_solves().expect("a supernodal factor");
+        let d_split = rel_diff(&x32, &solve(&mut single));
+        println!("f32 split solve vs faer's f32 solve: {d_split:.2e}");
+        assert!(d_split < 1e-5, "{d_split:.2e}");
+        let bytes32 = single.factor_bytes();
+        single.refactor_in(&kff, "box", FactorPrecision::Double).unwrap();
+        assert_eq!(single.precision(), FactorPrecision::Double);
+        assert_eq!(single.factor_bytes(), 2 * bytes32);
+        let d64 = rel_diff(&x64, &solve(&mut single));
+        assert!(d64 < 1e-12, "{d64:.2e}");
     }
 
     #[test]

@@ -26,7 +26,7 @@ pub mod ordering;
 pub mod tree_solve;
 
 pub use assemble::{add_entries, dof_map, from_columns, mass_matrix, restrict, stiffness, stiffness_of, Csc, NONE};
-pub use cholesky::{analyse, lu_solve_in_place, CholeskyAnalysis, SparseCholesky};
+pub use cholesky::{analyse, lu_solve_in_place, CholeskyAnalysis, FactorPrecision, SparseCholesky};
 pub use eigen::{lowest_modes, Modes, ModesOptions};
 pub use krylov::{gmres_into, GmresInfo, GmresOptions};
 pub use ordering::{nested_dissection, FillOrdering};

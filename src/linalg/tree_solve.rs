@@ -23,6 +23,12 @@ use faer::prelude::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::{Accum, MatMut, MatRef, Par};
 
+/// The scalars a factor may be stored in (f64, or f32 for a preconditioner:
+/// `linalg::cholesky::FactorPrecision`).
+pub trait Real: faer::traits::RealField + Copy + Send + Sync + std::ops::AddAssign + std::ops::SubAssign + From<f32> {}
+impl Real for f64 {}
+impl Real for f32 {}
+
 /// Expansions of the top tried when splitting the tree: 200. Why: each moves the heaviest
 /// subtree's root into the top and its children into the candidates; the best split (least
 /// top + larger bin) of the fine dam's factor is found within a few tens, and each trial costs a
@@ -115,11 +121,11 @@ impl TreeSplit {
 
     /// x ← (L Lᵀ)⁻¹ x for the permuted right-hand side `x` (length n), with the factor's
     /// `values` (faer's supernodal layout of `sn`).
-    pub fn solve_permuted(&self, sn: &SymbolicSupernodalCholesky<usize>, values: &[f64], x: &mut [f64]) {
+    pub fn solve_permuted<T: Real>(&self, sn: &SymbolicSupernodalCholesky<usize>, values: &[T], x: &mut [T]) {
         // forward, L y = x: the bins (their top rows accumulated from 0), then the top
         let forward_bin = |b: usize| {
             let mut xb = x.to_vec();
-            self.top_rows.iter().for_each(|&r| xb[r] = 0.0);
+            self.top_rows.iter().for_each(|&r| xb[r] = T::from(0.0));
             let mut tmp = Vec::new();
             for &s in &self.bins[b] {
                 forward(sn, values, s, &mut xb, &mut tmp);
@@ -150,7 +156,7 @@ impl TreeSplit {
 
     /// The bins' rows from their copies `x0`, `x1` into `x`; after a forward sweep also their
     /// updates of the top's rows (`x[r] += x0[r]`, then `+= x1[r]`).
-    fn merge(&self, sn: &SymbolicSupernodalCholesky<usize>, x: &mut [f64], x0: &[f64], x1: &[f64], forward: bool) {
+    fn merge<T: Real>(&self, sn: &SymbolicSupernodalCholesky<usize>, x: &mut [T], x0: &[T], x1: &[T], forward: bool) {
         let (begin, end) = (sn.supernode_begin(), sn.supernode_end());
         for (bin, xb) in self.bins.iter().zip([x0, x1]) {
             for &s in bin {
@@ -167,7 +173,7 @@ impl TreeSplit {
 }
 
 /// Supernode `s`'s columns of L (rows: its own columns, then its pattern).
-fn block<'a>(sn: &SymbolicSupernodalCholesky<usize>, values: &'a [f64], s: usize) -> MatRef<'a, f64> {
+fn block<'a, T: Real>(sn: &SymbolicSupernodalCholesky<usize>, values: &'a [T], s: usize) -> MatRef<'a, T> {
     let (begin, end, val_ptr) = (sn.supernode_begin(), sn.supernode_end(), sn.col_ptr_for_val());
     let ncols = end[s] - begin[s];
     let nrows = ncols + sn.supernode(s).pattern().len();
@@ -175,7 +181,7 @@ fn block<'a>(sn: &SymbolicSupernodalCholesky<usize>, values: &'a [f64], s: usize
 }
 
 /// Forward step of supernode `s`: x_s ← L_ss⁻¹ x_s, x_pattern −= L_ps x_s.
-fn forward(sn: &SymbolicSupernodalCholesky<usize>, values: &[f64], s: usize, x: &mut [f64], tmp: &mut Vec<f64>) {
+fn forward<T: Real>(sn: &SymbolicSupernodalCholesky<usize>, values: &[T], s: usize, x: &mut [T], tmp: &mut Vec<T>) {
     let (start, stop) = (sn.supernode_begin()[s], sn.supernode_end()[s]);
     let pattern = sn.supernode(s).pattern();
     let (l_top, l_bot) = block(sn, values, s).split_at_row(stop - start);
@@ -183,21 +189,21 @@ fn forward(sn: &SymbolicSupernodalCholesky<usize>, values: &[f64], s: usize, x: 
     let mut x_top = MatMut::from_column_major_slice_mut(&mut head[start..], stop - start, 1);
     solve_lower_triangular_in_place(l_top, x_top.rb_mut(), Par::Seq);
     tmp.clear();
-    tmp.resize(pattern.len(), 0.0);
-    matmul(MatMut::from_column_major_slice_mut(tmp, pattern.len(), 1), Accum::Replace, l_bot, x_top.rb(), 1.0, Par::Seq);
+    tmp.resize(pattern.len(), T::from(0.0));
+    matmul(MatMut::from_column_major_slice_mut(tmp, pattern.len(), 1), Accum::Replace, l_bot, x_top.rb(), T::from(1.0), Par::Seq);
     for (&r, t) in pattern.iter().zip(tmp.iter()) {
-        x[r] -= t;
+        x[r] -= *t;
     }
 }
 
 /// Backward step of supernode `s`: x_s ← L_ssᵀ⁻¹ (x_s − L_psᵀ x_pattern).
-fn backward(sn: &SymbolicSupernodalCholesky<usize>, values: &[f64], s: usize, x: &mut [f64], tmp: &mut Vec<f64>) {
+fn backward<T: Real>(sn: &SymbolicSupernodalCholesky<usize>, values: &[T], s: usize, x: &mut [T], tmp: &mut Vec<T>) {
     let (start, stop) = (sn.supernode_begin()[s], sn.supernode_end()[s]);
     let pattern = sn.supernode(s).pattern();
     let (l_top, l_bot) = block(sn, values, s).split_at_row(stop - start);
     tmp.clear();
     tmp.extend(pattern.iter().map(|&r| x[r]));
     let mut x_top = MatMut::from_column_major_slice_mut(&mut x[start..stop], stop - start, 1);
-    matmul(x_top.rb_mut(), Accum::Add, l_bot.transpose(), MatRef::from_column_major_slice(tmp, pattern.len(), 1), -1.0, Par::Seq);
+    matmul(x_top.rb_mut(), Accum::Add, l_bot.transpose(), MatRef::from_column_major_slice(tmp, pattern.len(), 1), T::from(-1.0), Par::Seq);
     solve_upper_triangular_in_place(l_top.transpose(), x_top, Par::Seq);
 }

@@ -51,7 +51,7 @@ use crate::contact::force::ContactSolver;
 use crate::contact::law::{PairHistory, PairState};
 use crate::contact::ContactState;
 use crate::error::{Error, ModelError};
-use crate::linalg::{add_entries, cpu_seconds, gmres_into, lu_solve_in_place, run_par, stiffness, Csc, FillOrdering, GmresOptions, SparseCholesky};
+use crate::linalg::{add_entries, cpu_seconds, gmres_into, lu_solve_in_place, run_par, stiffness, Csc, FactorPrecision, FillOrdering, GmresOptions, LinalgError, SparseCholesky};
 use crate::problem::Problem;
 use nalgebra::{Matrix3, Vector3};
 
@@ -121,7 +121,7 @@ impl StaticContactInfo {
     /// One line.
     pub fn line(&self) -> String {
         format!(
-            "{} Newton iterations ({} factorisations in {:.1} s ({:.1} s CPU on {} thread(s)), {} GMRES products in {:.1} s ({:.1} s CPU; preconditioner {:.1} s, operator {:.1} s){}; {:.1} s in all, setup {:.1} s; factor {:.0} MB, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products{}; directions {}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
+            "{} Newton iterations ({} factorisations in {:.1} s ({:.1} s CPU on {} thread(s)), {} GMRES products in {:.1} s ({:.1} s CPU; preconditioner {:.1} s, operator {:.1} s){}; {:.1} s in all, setup {:.1} s; factor {:.0} MB{}, {} {:.1} s, {:.2e} flops, a factorisation worth {:.0} products{}; directions {}), residual {:.1e}{}, pairs stick {} / slip {} / open {}{}{}, largest penetration {:.2e} m ({:.1e} of the largest displacement){}",
             self.iterations,
             self.solver.factorisations,
             self.solver.factor_seconds,
@@ -135,7 +135,8 @@ impl StaticContactInfo {
             if self.solver.lu_fallbacks > 0 { format!(", {} LU solves", self.solver.lu_fallbacks) } else { String::new() },
             self.seconds,
             self.setup_seconds,
-            self.solver.factor_entries as f64 * 8e-6,
+            self.solver.factor_bytes as f64 * 1e-6,
+            if self.solver.single { " in f32" } else if self.solver.single_fallback { " in f64 (the f32 factorisation lost a pivot)" } else { "" },
             if self.solver.nested_dissection { "nested dissection" } else { "AMD" },
             self.solver.analysis_seconds,
             self.solver.factor_flops,
@@ -253,8 +254,13 @@ pub struct DirectionStats {
     pub factorisations: usize,
     pub krylov_products: usize,
     pub lu_fallbacks: usize,
-    /// Entries of the preconditioner's Cholesky factor (8 B each).
+    /// Entries of the preconditioner's Cholesky factor, and their bytes (8 each in f64, 4 in
+    /// f32); whether the factor is f32 ([`SINGLE_FROM`]), and whether an f32 factorisation
+    /// lost a pivot so that f64 was used from then on.
     pub factor_entries: usize,
+    pub factor_bytes: usize,
+    pub single: bool,
+    pub single_fallback: bool,
     pub factor_seconds: f64,
     pub krylov_seconds: f64,
     /// Flops of one numeric factorisation and of one GMRES product (the refactorisation rule's
@@ -280,8 +286,12 @@ pub struct DirectionStats {
     pub split: Option<[usize; 3]>,
     /// Per Newton direction (separated by spaces) its GMRES products, an `F` before the count
     /// of an attempt on a fresh factorisation, a `>` after an attempt on a stale one that did
-    /// not converge within its cap (e.g. "F2 5 35>F3 14"), so the rule's choices can be read.
+    /// not converge within its cap, a `!` after one given up before its cap because its
+    /// residual could not reach the forcing term by then ([`GIVE_UP_WINDOW`]) (e.g.
+    /// "F2 5 35>F3 9!F2 14"), so the rule's choices can be read.
     pub trace: String,
+    /// Attempts on a stale factor given up before their cap ([`GIVE_UP_WINDOW`]).
+    pub given_up: usize,
 }
 
 /// The Newton direction d = K_T⁻¹ R with K_T = K̂ + Σ_p B_pᵀ (S_p + C_p) B_p (the pair tangents
@@ -293,7 +303,11 @@ pub struct DirectionStats {
 /// ([`products_per_factorisation`]), not on every change of a pair's state: K_T − P is then the friction couplings C_p (one rank-one
 /// term per slipping pair) and the changed blocks of the pairs that opened, slipped or moved
 /// since the factorisation, a correction of low rank that GMRES absorbs in a few products
-/// (on the fine dam a numeric factorisation costs as much as some hundred products).
+/// (on the fine dam a numeric factorisation costs as much as some hundred products). An
+/// attempt on a stale factor is capped at that many products and given up earlier when its
+/// residual's contraction cannot reach the forcing term by the cap ([`give_up_window`]); the
+/// direction is then solved on a fresh factorisation. From [`SINGLE_FROM`] unknowns the factor
+/// is f32 (GMRES stays f64 on the true operator).
 /// GMRES starts each direction from 0: the Newton directions of successive iterations are not
 /// close (the residual changes by orders of magnitude), so the last one is no better a start.
 struct TangentSolver {
@@ -304,8 +318,10 @@ struct TangentSolver {
     /// position in `p.val`.
     pair_pos: Vec<usize>,
     chol: Option<SparseCholesky>,
-    /// The fill-reducing ordering of P's analysis.
+    /// The fill-reducing ordering of P's analysis, and the precision of its factor
+    /// ([`SINGLE_FROM`]).
     ordering: FillOrdering,
+    precision: FactorPrecision,
     /// GMRES products since the last factorisation, and what one factorisation is worth in
     /// products ([`products_per_factorisation`]).
     products_since: usize,
@@ -313,6 +329,17 @@ struct TangentSolver {
     stats: DirectionStats,
     y: Vec<f64>,
 }
+
+/// Unknowns from which the preconditioner P is factorised in f32 (its solves rounding the
+/// vector to f32; GMRES, the operator and the Newton residual stay f64; if an f32
+/// factorisation loses a pivot, f64 from then on, said in the stage's note): 20 000. Why:
+/// measured on the dam (docs/performance.md §7b), the f32 factor halves P's memory and cut the
+/// CPU of a factorisation by a third (fine: 2.0 s against 3.0 s) and of a GMRES product by 38 %
+/// (0.068 s against 0.110 s), with the products per direction about the same and the static
+/// table equal to the f64 one to 2e-9 (the Newton tolerance is 1e-8); below 20 000 unknowns
+/// (the coarse dam, the tests' models) a factorisation takes a fraction of a second, and f64
+/// keeps their static states as they were.
+pub const SINGLE_FROM: usize = 20_000;
 
 /// How many times faster, in flops per second, a numeric factorisation runs than a GMRES
 /// product (dimensionless): 7. Why: the factorisation's supernodes are dense blocks
@@ -322,6 +349,25 @@ struct TangentSolver {
 /// / seconds per product against [`SparseCholesky::factor_flops`] / [`product_flops`] gave 7.9
 /// on the coarse dam mesh, 7.3 on the default, 7.0 on the fine.
 pub const FACTOR_SPEEDUP: f64 = 7.0;
+
+/// The least number of products over which a GMRES attempt on a stale preconditioner
+/// measures its residual's contraction, to give up before its cap when that contraction kept
+/// up to the cap would not reach the forcing term (`linalg::krylov::cannot_converge`; the
+/// preconditioner is then factorised at the current states and the direction solved again, as
+/// after an attempt that ran to its cap): 5 products. Why: a stale attempt's residual drops by
+/// a first product, then creeps on a plateau for a few products before it falls or stalls
+/// (docs/performance.md §7b); fewer than 5 products cannot tell the two apart (with 2 or 3 the
+/// coarse dam gave up attempts that would have converged: one factorisation more).
+pub const GIVE_UP_WINDOW: usize = 5;
+
+/// The window of a stale attempt with the cap `cap` (products): [`GIVE_UP_WINDOW`], or a
+/// quarter of the cap if more, so that the contraction is never extrapolated over more than
+/// three windows when first judged. Why: on the fine dam (cap 35) the plateaus are longer and a
+/// window of 5 extrapolated over 30 products gave up attempts that converged in 20–30: 16
+/// factorisations and 30 Newton iterations against 14 and 22 with 8 (docs/performance.md §7b).
+fn give_up_window(cap: usize) -> usize {
+    GIVE_UP_WINDOW.max(cap / 4)
+}
 
 /// Floating-point operations of one GMRES product with the preconditioner: the sparse product
 /// with P's pattern (2 per entry; the pair terms are of the same order), the two triangular
@@ -346,7 +392,7 @@ fn products_per_factorisation(factor_flops: f64, product_flops: f64) -> f64 {
 }
 
 impl TangentSolver {
-    fn new(k0: &Csc, pairs: &[Pair], ordering: FillOrdering) -> TangentSolver {
+    fn new(k0: &Csc, pairs: &[Pair], ordering: FillOrdering, precision: FactorPrecision) -> TangentSolver {
         let mut entries = Vec::new();
         for p in pairs {
             for wc in &p.w {
@@ -369,7 +415,7 @@ impl TangentSolver {
         }
         let pair_pos = entries.iter().map(|&(a, b, _)| pos(a, b)).collect();
         let n = k0.n_rows;
-        TangentSolver { p, k0_pos, pair_pos, chol: None, ordering, products_since: 0, budget: 1.0, stats: DirectionStats::default(), y: vec![0.0; n] }
+        TangentSolver { p, k0_pos, pair_pos, chol: None, ordering, precision, products_since: 0, budget: 1.0, stats: DirectionStats::default(), y: vec![0.0; n] }
     }
 
     /// P's values for the tangents `tangents`, then its numeric factorisation.
@@ -394,19 +440,20 @@ impl TangentSolver {
             }
         }
         let what = "static stage with the joints active: the Newton preconditioner K + the pairs' stiffness";
-        match self.chol.as_mut() {
-            Some(ch) => ch.refactor(&self.p, what),
-            None => SparseCholesky::factor_ordered(&self.p, what, run_par(), self.ordering).map(|mut ch| {
-                // the GMRES products' solves in two halves of the elimination tree at once
-                self.stats.split = ch.split_solves();
-                self.chol = Some(ch);
-            }),
+        let mut done = self.numeric(what, self.precision);
+        if matches!(done, Err(LinalgError::NotPositiveDefinite { .. })) && self.precision == FactorPrecision::Single {
+            // f32 lost a pivot: f64 from now on (on the same analysis after the first)
+            self.precision = FactorPrecision::Double;
+            self.stats.single_fallback = true;
+            done = self.numeric(what, FactorPrecision::Double);
         }
-        .map_err(|e| ModelError::Invalid(e.to_string()))?;
+        done.map_err(|e| ModelError::Invalid(e.to_string()))?;
         self.products_since = 0;
         self.stats.factorisations += 1;
         if let Some(ch) = self.chol.as_ref() {
             self.stats.factor_entries = ch.factor_entries();
+            self.stats.factor_bytes = ch.factor_bytes();
+            self.stats.single = ch.precision() == FactorPrecision::Single;
             self.stats.factor_flops = ch.factor_flops();
             self.stats.product_flops = product_flops(self.p.nnz(), ch.factor_entries(), ch.n());
             self.stats.analysis_seconds = ch.analysis_seconds();
@@ -417,6 +464,19 @@ impl TangentSolver {
         self.stats.factor_cpu_seconds += cpu_seconds() - cpu0;
         self.stats.threads = run_par().degree();
         self.stats.trace.push('F');
+        Ok(())
+    }
+
+    /// P's numeric factorisation in `precision`: on its analysis, or the first (analysis
+    /// included; the solves then split over the elimination tree).
+    fn numeric(&mut self, what: &str, precision: FactorPrecision) -> Result<(), LinalgError> {
+        if let Some(ch) = self.chol.as_mut() {
+            return ch.refactor_in(&self.p, what, precision);
+        }
+        let mut ch = SparseCholesky::factor_in(&self.p, what, run_par(), self.ordering, precision)?;
+        // the GMRES products' solves in two halves of the elimination tree at once
+        self.stats.split = ch.split_solves();
+        self.chol = Some(ch);
         Ok(())
     }
 
@@ -431,7 +491,11 @@ impl TangentSolver {
             // a refactorisation, then is refactorised at these states
             let fresh = changed || attempt > 0;
             let stale_cap = self.budget.ceil() as usize;
-            let opts = GmresOptions { tolerance: eta, max_iterations: if fresh { GmresOptions::default().max_iterations } else { stale_cap }, ..Default::default() };
+            let opts = if fresh {
+                GmresOptions { tolerance: eta, ..Default::default() }
+            } else {
+                GmresOptions { tolerance: eta, max_iterations: stale_cap, give_up_window: give_up_window(stale_cap), ..Default::default() }
+            };
             let (start, cpu0) = (std::time::Instant::now(), cpu_seconds());
             let chol = self.chol.as_mut().expect("factorised above");
             self.y.fill(0.0);
@@ -464,7 +528,10 @@ impl TangentSolver {
             self.stats.krylov_cpu_seconds += cpu_seconds() - cpu0;
             self.stats.precondition_seconds += precondition_s;
             self.stats.operator_seconds += operator_s;
-            self.stats.trace.push_str(&format!("{}{}", g.iterations, if g.converged { " " } else { ">" }));
+            self.stats.trace.push_str(&format!("{}{}", g.iterations, if g.converged { " " } else if g.gave_up { "!" } else { ">" }));
+            if g.gave_up {
+                self.stats.given_up += 1;
+            }
             self.products_since += g.iterations;
             if g.converged {
                 r.copy_from_slice(&self.y);
@@ -534,6 +601,12 @@ pub const STATIC_ORDERING: FillOrdering = FillOrdering::Auto;
 
 /// [`solve_static_increment`] with the preconditioner's fill-reducing ordering `ordering`.
 pub fn solve_static_increment_ordered(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64, ordering: FillOrdering) -> Result<(Vec<f64>, StaticContactInfo), Error> {
+    solve_static_increment_in(problem, f, contact, penalty_factor, ordering, None)
+}
+
+/// [`solve_static_increment_ordered`] with the preconditioner's factor in `precision` (`None`:
+/// the rule, [`SINGLE_FROM`]).
+pub fn solve_static_increment_in(problem: &Problem, f: &[f64], contact: &mut ContactState, penalty_factor: f64, ordering: FillOrdering, precision: Option<FactorPrecision>) -> Result<(Vec<f64>, StaticContactInfo), Error> {
     let start = std::time::Instant::now();
     let model = &problem.model;
     let k_full = stiffness(model, &vec![true; model.materials.len()]);
@@ -545,7 +618,8 @@ pub fn solve_static_increment_ordered(problem: &Problem, f: &[f64], contact: &mu
     let mut pairs = active_pairs(problem, &t, &k_full, contact, penalty_factor, &mut info)?;
     let residual = Residual { k0: &k0, f0: &f0, joints: &problem.joints, nf: norm(&f0) };
     info.setup_seconds = start.elapsed().as_secs_f64();
-    let uh = newton(&residual, &mut pairs, t.n, ordering, &mut info)?;
+    let precision = precision.unwrap_or(if t.n >= SINGLE_FROM { FactorPrecision::Single } else { FactorPrecision::Double });
+    let uh = newton(&residual, &mut pairs, t.n, (ordering, precision), &mut info)?;
     // the result and the pairs' records
     let mut du = vec![0.0; t.n_dofs];
     t.expand_into(&uh, &mut du);
@@ -567,7 +641,7 @@ pub fn static_matrices(problem: &Problem) -> Result<(Csc, Csc), Error> {
     let k0 = t.reduce(&k_full);
     let contact = ContactState::new(&problem.joints);
     let pairs = active_pairs(problem, &t, &k_full, &contact, PENALTY_FACTOR, &mut StaticContactInfo::default())?;
-    let p = TangentSolver::new(&k0, &pairs, STATIC_ORDERING).p;
+    let p = TangentSolver::new(&k0, &pairs, STATIC_ORDERING, FactorPrecision::Double).p;
     Ok((k0, p))
 }
 
@@ -680,14 +754,14 @@ impl Residual<'_> {
 /// Newton's iteration on the `n` reduced unknowns from 0, with a backtracking line search;
 /// counts each pair's state changes, writes the iterations, residual and solver statistics
 /// into `info`. Returns the reduced solution.
-fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, ordering: FillOrdering, info: &mut StaticContactInfo) -> Result<Vec<f64>, Error> {
+fn newton(residual: &Residual, pairs: &mut [Pair], n: usize, (ordering, precision): (FillOrdering, FactorPrecision), info: &mut StaticContactInfo) -> Result<Vec<f64>, Error> {
     let k0 = residual.k0;
     let mut uh = vec![0.0; n];
     let (mut r, mut r_try) = (vec![0.0; n], vec![0.0; n]);
     let (mut closed, mut closed_try) = (Vec::new(), Vec::new());
     let mut tangents = Vec::with_capacity(pairs.len());
     let mut u_try = vec![0.0; n];
-    let mut solver = TangentSolver::new(k0, pairs, ordering);
+    let mut solver = TangentSolver::new(k0, pairs, ordering, precision);
     let (mut res_prev, mut eta) = (None, FORCING_MAX);
     for it in 0..=MAX_ITERATIONS {
         crate::interrupt::check("the static state (Newton iterations with contact)")?;

@@ -675,6 +675,42 @@ fn dam_static_state_is_the_same_with_nested_dissection_as_with_amd() {
     assert!(dc < 1e-8, "{dc}");
 }
 
+/// Stage c of the construction sequence on the coarse dam with the Newton preconditioner's
+/// Cholesky factor in f32 (`FactorPrecision::Single`: half the memory, the GMRES products'
+/// solves rounding to f32) against f64. GMRES works on the f64 operator and Newton on the f64
+/// residual either way, so only the path's round-off and the products differ. Reference: the
+/// f64 solution. Tolerance: Δu to 1e-8 of its largest entry (Newton stops at ‖R‖/‖F‖ < 1e-8 on
+/// either path), the same pair counts in each state; the f32 factor has 4 bytes an entry (the
+/// f64 one 8) and was not replaced by f64 (no pivot lost).
+#[test]
+fn dam_static_state_is_the_same_with_a_single_precision_preconditioner() {
+    use jointquake::linalg::{FactorPrecision, FillOrdering};
+    let pb = dam_static_problem();
+    let (u, _) = jointquake::statics::sequence::self_weight_open_joints(&pb).unwrap();
+    let mut f = vec![0.0; u.len()];
+    for &(n, fv) in &pb.loads.static_forces {
+        for c in 0..3 {
+            f[3 * n + c] += fv[c];
+        }
+    }
+    let solve = |precision| {
+        let mut contact = jointquake::contact::ContactState::new(&pb.joints);
+        jointquake::statics::sequence::grout(&pb, &mut contact, &u).unwrap();
+        jointquake::statics::contact::solve_static_increment_in(&pb, &f, &mut contact, jointquake::statics::contact::PENALTY_FACTOR, FillOrdering::Auto, Some(precision)).unwrap()
+    };
+    let (d64, i64) = solve(FactorPrecision::Double);
+    let (d32, i32) = solve(FactorPrecision::Single);
+    println!("f64: {}\nf32: {}", i64.line(), i32.line());
+    assert!(i64.converged && i32.converged);
+    assert!(i32.solver.single && !i32.solver.single_fallback && !i64.solver.single, "{}", i32.line());
+    assert_eq!((i32.solver.factor_bytes, i64.solver.factor_bytes), (4 * i32.solver.factor_entries, 8 * i64.solver.factor_entries));
+    assert_eq!((i64.stick, i64.slip, i64.open), (i32.stick, i32.slip, i32.open));
+    let scale = d64.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let d = d64.iter().zip(&d32).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / scale;
+    println!("stage c: largest difference {d:.2e} of the largest displacement");
+    assert!(d < 1e-8, "{d}");
+}
+
 /// The static state's factorisations on the run's threads (issue 30 §1, `linalg::run_par`):
 /// the coarse dam's construction sequence in a rayon pool of one thread and of two. Reference:
 /// the one-thread static table (crest radial displacements, crown stresses). Tolerance: 1e-10
