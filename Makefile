@@ -178,7 +178,9 @@ dam-coarse:
 # pipelines/dam_reference.json that `make dam`'s report reads. Not run whole here: the h 2.5 m
 # runs alone take hours (about 8x the fine mesh's elements at half its time step).
 # DAM_CONVERGENCE=pipelines/dam_convergence_affordable_study.json: coarse and default only
-# (8 runs, about 18 CPU-minutes; the committed reference's runs).
+# (8 runs, about 18 CPU-minutes). DAM_CONVERGENCE=pipelines/dam_convergence_three_study.json:
+# coarse, default and fine (12 runs; the fine ones 15-18 min each on one core, about 67 min with
+# JOBS=2; the committed reference's runs, docs/dam.md "Convergence").
 DAM_CONVERGENCE ?= pipelines/dam_convergence_study.json
 dam-convergence:
 	-$(MAKE) --no-print-directory study STUDY=$(DAM_CONVERGENCE)
