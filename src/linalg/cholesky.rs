@@ -93,7 +93,7 @@ impl SparseCholesky {
         let ordering = ordering.resolve(n);
         let symbolic = symbolic_analysis(a, what, ordering)?;
         let analysis_seconds = start.elapsed().as_secs_f64();
-        let mut chol = SparseCholesky { symbolic, values: Values::Double(Vec::new()), scratch: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY), scratch_cols: 1, par, pattern_nnz: a.nnz(), ordering, analysis_seconds, split: None, permuted: Vec::new() };
+        let mut chol = SparseCholesky { symbolic, values: Values::Double(Vec::new()), scratch: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY), scratch_cols: 0, par, pattern_nnz: a.nnz(), ordering, analysis_seconds, split: None, permuted: Vec::new() };
         chol.refactor_in(a, what, precision)?;
         Ok(chol)
     }
@@ -103,7 +103,9 @@ impl SparseCholesky {
     pub fn refactor_in(&mut self, a: &Csc, what: &str, precision: FactorPrecision) -> Result<(), LinalgError> {
         let (n, len) = (self.n(), self.symbolic.len_val());
         let oom = || LinalgError::OutOfMemory { what: what.to_string(), n };
-        if self.precision() != precision || self.factor_entries() != len {
+        // scratch_cols 0: made by `factor_in`, nothing allocated yet (an empty factor, len 0,
+        // already has the right number of values but still needs the solve's scratch)
+        if self.precision() != precision || self.factor_entries() != len || self.scratch_cols == 0 {
             // the old values go first: the two factors need not fit at once
             self.values = Values::Double(Vec::new());
             let (values, scratch) = match precision {
@@ -362,6 +364,22 @@ mod tests {
     fn rel_diff<T: Into<f64> + Copy>(a: &[T], b: &[T]) -> f64 {
         let scale = a.iter().fold(0.0f64, |m, &v| m.max(v.into().abs()));
         a.iter().zip(b).map(|(&x, &y)| (x.into() - y.into()).abs()).fold(0.0, f64::max) / scale
+    }
+
+    /// Regression: with the f32 option, `factor_in` allocated the values and the solve's scratch
+    /// only when the factor's entry count changed, so a factor with no entries (a model whose
+    /// condensed block is empty: the tied-interface joint test) kept an empty scratch and faer's
+    /// solve panicked ("buffer is not large enough to accomodate the requested alignment").
+    #[test]
+    fn regression_an_empty_factor_solved_with_an_empty_scratch() {
+        let empty = Csc { n_rows: 0, n_cols: 0, col_ptr: vec![0], row: Vec::new(), val: Vec::new() };
+        for precision in [FactorPrecision::Double, FactorPrecision::Single] {
+            let mut ch = SparseCholesky::factor_in(&empty, "empty", Par::Seq, FillOrdering::Amd, precision).unwrap();
+            let mut x: Vec<f64> = Vec::new();
+            ch.solve_in_place(&mut x);
+            ch.refactor(&empty, "empty").unwrap();
+            ch.solve_in_place(&mut x);
+        }
     }
 
     #[test]
