@@ -164,6 +164,18 @@ pub struct Loads {
 }
 
 impl Loads {
+    /// The static forces (`static_forces`) as a nodal force vector of `n_dofs` entries [N]: the
+    /// right-hand side of the construction sequence's stage c.
+    pub fn static_force_vector(&self, n_dofs: usize) -> Vec<f64> {
+        let mut f = vec![0.0; n_dofs];
+        for &(n, fv) in &self.static_forces {
+            for c in 0..3 {
+                f[3 * n + c] += fv[c];
+            }
+        }
+        f
+    }
+
     /// Resolve the scene's loads on the model (groups, records, snapping).
     pub fn build(model: &Model, scene: &Scene) -> Result<(Loads, Vec<String>), Error> {
         let mut notes = Vec::new();

@@ -231,12 +231,7 @@ pub fn construction_into(p: &Problem, contact: &mut ContactState, u: &mut [f64])
     // (`static_contact`). Dynamic relaxation, started from the linear response with
     // every joint bonded, had not converged on the arch dam (residual 2.2e-2 after
     // 40 000 steps; 5.4e-2 ramped in from rest).
-    let mut f_static = vec![0.0; u.len()];
-    for &(n, fv) in &p.loads.static_forces {
-        for c in 0..3 {
-            f_static[3 * n + c] += fv[c];
-        }
-    }
+    let f_static = p.loads.static_force_vector(u.len());
     let (du, info) = solve_static_increment(p, &f_static, contact, crate::statics::contact::PENALTY_FACTOR)?;
     if !info.converged {
         return Err(ModelError::Invalid(format!(

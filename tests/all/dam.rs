@@ -632,6 +632,16 @@ fn dam_reservoir_stage_with_active_joints_converges_and_its_penalty_error_is_sma
     assert!((a / b - 1.0).abs() < 1e-3);
 }
 
+/// Stage c of the construction sequence from the stage-a state `u`: the joints grouted at `u`,
+/// then the static forces with the joints active, with the given ordering and preconditioner
+/// precision (`None`: the rule's).
+fn grouted_stage_c(pb: &jointquake::problem::Problem, u: &[f64], ordering: jointquake::linalg::FillOrdering, precision: Option<jointquake::linalg::FactorPrecision>) -> (Vec<f64>, jointquake::statics::contact::StaticContactInfo) {
+    let f = pb.loads.static_force_vector(u.len());
+    let mut contact = jointquake::contact::ContactState::new(&pb.joints);
+    jointquake::statics::sequence::grout(pb, &mut contact, u).unwrap();
+    jointquake::statics::contact::solve_static_increment_in(pb, &f, &mut contact, jointquake::statics::contact::PENALTY_FACTOR, ordering, precision).unwrap()
+}
+
 /// The static state on the coarse dam with METIS nested dissection instead of AMD for the
 /// Cholesky factorisations (stage a's K̂, stage c's preconditioner): the ordering changes only
 /// the round-off of the direct solves and, in stage c, which GMRES products the preconditioner
@@ -653,19 +663,8 @@ fn dam_static_state_is_the_same_with_nested_dissection_as_with_amd() {
     let da = rel(&ua, &un);
     println!("stage a: largest difference {da:.2e} of the largest displacement");
     assert!(da < 1e-10, "{da}");
-    let mut f = vec![0.0; ua.len()];
-    for &(n, fv) in &pb.loads.static_forces {
-        for c in 0..3 {
-            f[3 * n + c] += fv[c];
-        }
-    }
-    let solve = |ordering| {
-        let mut contact = jointquake::contact::ContactState::new(&pb.joints);
-        jointquake::statics::sequence::grout(&pb, &mut contact, &ua).unwrap();
-        jointquake::statics::contact::solve_static_increment_ordered(&pb, &f, &mut contact, jointquake::statics::contact::PENALTY_FACTOR, ordering).unwrap()
-    };
-    let (dua, ia) = solve(FillOrdering::Amd);
-    let (dun, inn) = solve(FillOrdering::NestedDissection);
+    let (dua, ia) = grouted_stage_c(&pb, &ua, FillOrdering::Amd, None);
+    let (dun, inn) = grouted_stage_c(&pb, &ua, FillOrdering::NestedDissection, None);
     println!("AMD: {}\nND:  {}", ia.line(), inn.line());
     assert!(ia.converged && inn.converged);
     assert!(inn.solver.nested_dissection && !ia.solver.nested_dissection);
@@ -687,19 +686,8 @@ fn dam_static_state_is_the_same_with_a_single_precision_preconditioner() {
     use jointquake::linalg::{FactorPrecision, FillOrdering};
     let pb = dam_static_problem();
     let (u, _) = jointquake::statics::sequence::self_weight_open_joints(&pb).unwrap();
-    let mut f = vec![0.0; u.len()];
-    for &(n, fv) in &pb.loads.static_forces {
-        for c in 0..3 {
-            f[3 * n + c] += fv[c];
-        }
-    }
-    let solve = |precision| {
-        let mut contact = jointquake::contact::ContactState::new(&pb.joints);
-        jointquake::statics::sequence::grout(&pb, &mut contact, &u).unwrap();
-        jointquake::statics::contact::solve_static_increment_in(&pb, &f, &mut contact, jointquake::statics::contact::PENALTY_FACTOR, FillOrdering::Auto, Some(precision)).unwrap()
-    };
-    let (d64, i64) = solve(FactorPrecision::Double);
-    let (d32, i32) = solve(FactorPrecision::Single);
+    let (d64, i64) = grouted_stage_c(&pb, &u, FillOrdering::Auto, Some(FactorPrecision::Double));
+    let (d32, i32) = grouted_stage_c(&pb, &u, FillOrdering::Auto, Some(FactorPrecision::Single));
     println!("f64: {}\nf32: {}", i64.line(), i32.line());
     assert!(i64.converged && i32.converged);
     assert!(i32.solver.single && !i32.solver.single_fallback && !i64.solver.single, "{}", i32.line());
