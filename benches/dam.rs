@@ -177,10 +177,13 @@ fn main() {
                 let mut sweeps = 0usize;
                 let step = |n: usize, sim: &mut Simulation, sweeps: &mut usize| {
                     let t = Instant::now();
-                    for _ in 0..n {
-                        let info = sim.step().expect("step");
-                        *sweeps += info.correction.iterations;
-                    }
+                    // as `pipeline::run` steps: the pool's other workers kept awake
+                    jointquake::par::with_awake_workers(|| {
+                        for _ in 0..n {
+                            let info = sim.step().expect("step");
+                            *sweeps += info.correction.iterations;
+                        }
+                    });
                     t.elapsed().as_secs_f64()
                 };
                 step(100, &mut sim, &mut sweeps);

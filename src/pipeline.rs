@@ -143,7 +143,9 @@ fn run_phases(mut scene: Scene, scene_path: &Path, opts: &RunOptions, inspect: &
         laps.lap("equilibrium");
         inspect(&sim, &out_dir)?;
         let mut recorder = Recorder::create(&sim, &out_dir, opts.progress)?;
-        sim.run(&mut recorder)?;
+        // the time loop with the pool's other workers kept awake between the step's parallel
+        // regions (`par::with_awake_workers`: why, and what it costs)
+        crate::par::with_awake_workers(|| sim.run(&mut recorder))?;
         laps.lap("dynamic");
         let summary = recorder.summary(&sim, mesh_path, laps.timings.clone(), t_all.elapsed().as_secs_f64());
         summary.write(&out_dir)?;
