@@ -42,7 +42,7 @@ pub fn fork_joins() -> u64 {
 /// the kernel's sleeping and waking was 42 % of the extra CPU of two threads over one, and
 /// keeping the worker awake took 4–6 % off the two-thread step (median 1.58× → 1.67× over eight pairs,
 /// docs/performance.md §7, "Workers kept awake"). The price is CPU: the kept worker spins through
-/// the serial stretches (about 6 % more CPU a step on the fine dam), so a run on `--threads 2`
+/// the serial stretches (about 7 % more CPU a step on the fine dam), so a run on `--threads 2`
 /// takes its two cores whole, as the thread count says it may.
 ///
 /// Results do not depend on it: it changes which thread runs a piece of work, never the order in
