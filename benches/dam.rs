@@ -340,7 +340,7 @@ fn static_scene(size: &str) -> (std::path::PathBuf, serde_json::Value) {
 fn static_fill() -> Vec<serde_json::Value> {
     use jointquake::linalg::{analyse, FillOrdering};
     let mut rows = Vec::new();
-    for (size, _, problem) in static_problems("JQ_DAM_FILL") {
+    for (size, _, _, problem) in static_problems("JQ_DAM_FILL") {
         let (k0, p) = match problem.and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
             Ok(m) => m,
             Err(e) => {
@@ -376,7 +376,7 @@ fn static_factor() -> Vec<serde_json::Value> {
     use jointquake::linalg::{FillOrdering, SparseCholesky};
     let repeats: usize = std::env::var("JQ_FACTOR_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(2usize).max(1);
     let mut rows = Vec::new();
-    for (size, _, problem) in static_problems("JQ_DAM_FACTOR") {
+    for (size, _, _, problem) in static_problems("JQ_DAM_FACTOR") {
         let p = match problem.and_then(|pb| jointquake::statics::contact::static_matrices(&pb).map_err(|e| e.to_string())) {
             Ok((_, p)) => p,
             Err(e) => {
@@ -573,7 +573,7 @@ fn cpu_and_peak() -> (f64, f64) {
 fn static_state() -> Vec<serde_json::Value> {
     let mut rows = Vec::new();
     let mut t_mesh = Instant::now();
-    for (size, path, problem) in static_problems("JQ_DAM_STATIC") {
+    for (size, path, scene, problem) in static_problems("JQ_DAM_STATIC") {
         // the mesh is made (and the model built, then dropped) before the timed run
         if let Err(e) = problem {
             println!("static state, {size}: skipped ({e})");
@@ -582,7 +582,6 @@ fn static_state() -> Vec<serde_json::Value> {
         }
         drop(problem);
         let mesh_s = t_mesh.elapsed().as_secs_f64();
-        let scene: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).expect("the bench scene")).expect("the bench scene is JSON");
         let cache = root().join("target/bench-mesh");
         let opts = jointquake::pipeline::RunOptions { out_dir: Some(root().join("target/bench-static").join(&size)), mesh_cache: Some(cache), progress: false, duration: Some(0.0), threads: None };
         let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
@@ -660,18 +659,18 @@ fn element_schedule_bounds(model: &jointquake::model::Model, skip_massless: bool
 }
 
 /// The meshes of the env list `var` (comma list of coarse, default, fine, h2.5; unset or empty:
-/// none), one after the other: each mesh's name, its bench scene (`static_scene`) and the
+/// none), one after the other: each mesh's name, its bench scene (`static_scene`: file and JSON) and the
 /// model on the mesh loaded from target/bench-mesh (meshed there first if missing), or why
 /// not. Lazy, so that one model is in memory at a time.
-fn static_problems(var: &str) -> impl Iterator<Item = (String, PathBuf, Result<Problem, String>)> {
+fn static_problems(var: &str) -> impl Iterator<Item = (String, PathBuf, serde_json::Value, Result<Problem, String>)> {
     let sizes: Vec<String> = std::env::var(var).unwrap_or_default().split(',').map(str::trim).filter(|s| !s.is_empty()).map(String::from).collect();
     sizes.into_iter().map(|size| {
-        let (path, _) = static_scene(&size);
+        let (path, scene) = static_scene(&size);
         let cache = root().join("target/bench-mesh");
         let problem = jointquake::scene::Scene::load(&path).map_err(|e| e.to_string()).and_then(|mut s| {
             let mesh = jointquake::pipeline::load_scene_mesh(&mut s, &path, Some(&cache)).map_err(|e| e.to_string())?;
             Problem::build(s, mesh).map_err(|e| e.to_string())
         });
-        (size, path, problem)
+        (size, path, scene, problem)
     })
 }

@@ -168,12 +168,17 @@ impl Loads {
     /// right-hand side of the construction sequence's stage c.
     pub fn static_force_vector(&self, n_dofs: usize) -> Vec<f64> {
         let mut f = vec![0.0; n_dofs];
+        self.add_static_forces_into(&mut f);
+        f
+    }
+
+    /// f += the static forces (`static_forces`) [N].
+    fn add_static_forces_into(&self, f: &mut [f64]) {
         for &(n, fv) in &self.static_forces {
             for c in 0..3 {
                 f[3 * n + c] += fv[c];
             }
         }
-        f
     }
 
     /// Resolve the scene's loads on the model (groups, records, snapping).
@@ -276,11 +281,7 @@ impl Loads {
             }
         }
         if with_gravity {
-            for &(n, fv) in &self.static_forces {
-                for i in 0..3 {
-                    f[3 * n + i] += fv[i];
-                }
-            }
+            self.add_static_forces_into(f);
         }
         if with_dynamic {
             for p in &self.patterns {

@@ -108,15 +108,11 @@ impl SparseCholesky {
         if self.precision() != precision || self.factor_entries() != len || self.scratch_cols == 0 {
             // the old values go first: the two factors need not fit at once
             self.values = Values::Double(Vec::new());
-            let (values, scratch) = match precision {
-                FactorPrecision::Double => (Values::Double(zeros(len).ok_or_else(oom)?), self.symbolic.solve_in_place_scratch::<f64>(1, SOLVE_PAR)),
-                FactorPrecision::Single => {
-                    let values = Values::Single { l: zeros(len).ok_or_else(oom)?, a: zeros(self.pattern_nnz).ok_or_else(oom)?, x: zeros(n).ok_or_else(oom)? };
-                    (values, self.symbolic.solve_in_place_scratch::<f32>(1, SOLVE_PAR))
-                }
+            self.values = match precision {
+                FactorPrecision::Double => Values::Double(zeros(len).ok_or_else(oom)?),
+                FactorPrecision::Single => Values::Single { l: zeros(len).ok_or_else(oom)?, a: zeros(self.pattern_nnz).ok_or_else(oom)?, x: zeros(n).ok_or_else(oom)? },
             };
-            self.values = values;
-            self.scratch = MemBuffer::try_new(scratch).map_err(|_| oom())?;
+            self.scratch = MemBuffer::try_new(self.solve_scratch(1, SOLVE_PAR)).map_err(|_| oom())?;
             self.scratch_cols = 1;
         }
         self.refactor(a, what)
@@ -238,13 +234,18 @@ impl SparseCholesky {
         self.solve_mat_in_place(rhs);
     }
 
+    /// The scratch faer's solve needs for `cols` right-hand sides, in the factor's precision.
+    fn solve_scratch(&self, cols: usize, par: Par) -> faer::dyn_stack::StackReq {
+        match self.values {
+            Values::Double(_) => self.symbolic.solve_in_place_scratch::<f64>(cols, par),
+            Values::Single { .. } => self.symbolic.solve_in_place_scratch::<f32>(cols, par),
+        }
+    }
+
     /// X ← A⁻¹ X for a column-major block of right-hand sides.
     pub fn solve_mat_in_place(&mut self, rhs: MatMut<'_, f64>) {
         if rhs.ncols() > self.scratch_cols {
-            self.scratch = MemBuffer::new(match self.values {
-                Values::Double(_) => self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), SOLVE_PAR),
-                Values::Single { .. } => self.symbolic.solve_in_place_scratch::<f32>(rhs.ncols(), SOLVE_PAR),
-            });
+            self.scratch = MemBuffer::new(self.solve_scratch(rhs.ncols(), SOLVE_PAR));
             self.scratch_cols = rhs.ncols();
         }
         solve_with(&self.symbolic, &self.values, rhs, SOLVE_PAR, MemStack::new(&mut self.scratch));
@@ -254,11 +255,7 @@ impl SparseCholesky {
     /// in parallel on a shared factorisation.
     pub fn solve_block_in_place(&self, rhs: MatMut<'_, f64>) -> Result<(), LinalgError> {
         let n = self.n();
-        let bytes = match self.values {
-            Values::Double(_) => self.symbolic.solve_in_place_scratch::<f64>(rhs.ncols(), Par::Seq),
-            Values::Single { .. } => self.symbolic.solve_in_place_scratch::<f32>(rhs.ncols(), Par::Seq),
-        };
-        let mut scratch = MemBuffer::try_new(bytes).map_err(|_| LinalgError::OutOfMemory { what: "solve scratch".into(), n })?;
+        let mut scratch = MemBuffer::try_new(self.solve_scratch(rhs.ncols(), Par::Seq)).map_err(|_| LinalgError::OutOfMemory { what: "solve scratch".into(), n })?;
         solve_with(&self.symbolic, &self.values, rhs, Par::Seq, MemStack::new(&mut scratch));
         Ok(())
     }

@@ -632,6 +632,12 @@ fn dam_reservoir_stage_with_active_joints_converges_and_its_penalty_error_is_sma
     assert!((a / b - 1.0).abs() < 1e-3);
 }
 
+/// The largest |a − b| relative to the largest |a|.
+fn largest_rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
+}
+
 /// Stage c of the construction sequence from the stage-a state `u`: the joints grouted at `u`,
 /// then the static forces with the joints active, with the given ordering and preconditioner
 /// precision (`None`: the rule's).
@@ -656,11 +662,7 @@ fn dam_static_state_is_the_same_with_nested_dissection_as_with_amd() {
     let (ua, _) = jointquake::statics::sequence::self_weight_open_joints_ordered(&pb, FillOrdering::Amd).unwrap();
     let (un, stage) = jointquake::statics::sequence::self_weight_open_joints_ordered(&pb, FillOrdering::NestedDissection).unwrap();
     assert!(stage.note.contains("nested dissection"), "{}", stage.note);
-    let rel = |a: &[f64], b: &[f64]| {
-        let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale
-    };
-    let da = rel(&ua, &un);
+    let da = largest_rel_diff(&ua, &un);
     println!("stage a: largest difference {da:.2e} of the largest displacement");
     assert!(da < 1e-10, "{da}");
     let (dua, ia) = grouted_stage_c(&pb, &ua, FillOrdering::Amd, None);
@@ -669,7 +671,7 @@ fn dam_static_state_is_the_same_with_nested_dissection_as_with_amd() {
     assert!(ia.converged && inn.converged);
     assert!(inn.solver.nested_dissection && !ia.solver.nested_dissection);
     assert_eq!((ia.stick, ia.slip, ia.open), (inn.stick, inn.slip, inn.open));
-    let dc = rel(&dua, &dun);
+    let dc = largest_rel_diff(&dua, &dun);
     println!("stage c: largest difference {dc:.2e} of the largest displacement");
     assert!(dc < 1e-8, "{dc}");
 }
@@ -693,8 +695,7 @@ fn dam_static_state_is_the_same_with_a_single_precision_preconditioner() {
     assert!(i32.solver.single && !i32.solver.single_fallback && !i64.solver.single, "{}", i32.line());
     assert_eq!((i32.solver.factor_bytes, i64.solver.factor_bytes), (4 * i32.solver.factor_entries, 8 * i64.solver.factor_entries));
     assert_eq!((i64.stick, i64.slip, i64.open), (i32.stick, i32.slip, i32.open));
-    let scale = d64.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let d = d64.iter().zip(&d32).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max) / scale;
+    let d = largest_rel_diff(&d64, &d32);
     println!("stage c: largest difference {d:.2e} of the largest displacement");
     assert!(d < 1e-8, "{d}");
 }
