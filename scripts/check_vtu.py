@@ -12,7 +12,7 @@ are finite (except a joint's gap, NaN where a slave node found no master face); 
 stresses are ordered; joint states are 0..3 and openings >= 0; the number of frames of the
 volume series and of every joint series equals summary.json, and every joint series has the
 volume series' times (one time axis); every history CSV starts with its header (units in the
-names) and has rows of finite numbers (monitors: the 10 columns t,u,v,a; joints: the 14
+names) and has rows of finite numbers (monitors: the 10 columns t,u,v,a; joints: the 17
 documented columns), its last row at the last frame's time. Frames are binary, zlib-compressed.
 Without summary.json (a killed run) the series alone are checked. Exits non-zero with a
 message naming the file on any failure.
@@ -32,7 +32,7 @@ JOINT_POINT = {"displacement": 3, "normal": 3, "gap": 1, "opening": 1, "slip": 1
                "tributary_area": 1}
 MONITOR_HEADER = "t [s],ux [m],uy [m],uz [m],vx [m/s],vy [m/s],vz [m/s],ax [m/s^2],ay [m/s^2],az [m/s^2]"
 JOINT_HEADER = ("t [s],max_opening [m],max_slip [m],max_tangential_displacement [m],max_penetration [m],open,stick,slip,"
-                "bonded,sweeps,normal_force [N],shear_force [N],lost,max_lost_travel [m]")
+                "bonded,sweeps,normal_force [N],shear_force [N],lost,max_lost_travel [m],contact_work [J],reentries,reentry_work [J]")
 
 
 def fail(msg):
@@ -107,7 +107,7 @@ def check_history(h, t_end=None):
     if base.endswith("_forces.csv"):
         return  # the opt-in force diagnostic: its own reader (read_joint_forces) checks it
     joint = base.startswith("joint_")
-    header, ncol = (JOINT_HEADER, 14) if joint else (MONITOR_HEADER, 10)
+    header, ncol = (JOINT_HEADER, 17) if joint else (MONITOR_HEADER, 10)
     if lines[0] != header:
         fail(f"{h}: first line {lines[0]!r}, expected the header {header!r}")
     if len(lines) < 2:

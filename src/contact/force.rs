@@ -234,9 +234,21 @@ fn lose_pair(p: &mut PairRecord, ev: &mut SearchEvents) {
     ev.lost += 1;
     p.face = -1;
     p.gap = f64::NAN;
+    p.entry_offset = 0.0;
     p.r_n = 0.0;
     p.r_t = [0.0; 2];
     p.state = PairState::Open;
+}
+
+/// The gap of slave node `i` of joint `j` on master point `pm` at displacement `conf` [m] (the
+/// grouting offset subtracted, the held re-entry offset not): the gap it re-enters with.
+fn predicted_gap(model: &Model, j: &ContactJoint, pr: &PairRecord, i: usize, pm: &PairMasters, conf: &[f64]) -> f64 {
+    let s = j.tag.slave_nodes()[i];
+    let mut xbar = Vector3::zeros();
+    for a in 0..pm.nm as usize {
+        xbar += pos(model, conf, pm.nodes[a] as usize) * pm.weights[a];
+    }
+    j.frames[i][0].dot(&(xbar - pos(model, conf, s))) - pr.gap_offset
 }
 
 /// Slave node `i`'s pair is not formed (`joint::unformed_pairs`: the tie fixes the node):
@@ -1071,6 +1083,10 @@ impl ContactSolver<'_> {
                 continue;
             }
             let Some(mobility) = self.pair_mobility(model, s, &j.frames[i][0], &pm) else { continue };
+            if j.hold_reentry && pr.gap.is_nan() && !matches!(j.method, Method::Penalty { .. }) {
+                // re-entry: its predicted penetration counts as closed (`PairRecord::entry_offset`)
+                pr.entry_offset = predicted_gap(model, j, pr, i, &pm, conf).min(0.0);
+            }
             if let Method::Penalty { kn, kt } = j.method {
                 penalty.push(self.penalty_pair_into(model, j, pr, i, &pm, (kn, kt), &xs, u_prev, u));
             } else {
@@ -1512,8 +1528,8 @@ impl ContactSolver<'_> {
             frame: j.frames[i],
             area,
             hist0: pr.hist,
-            // the grouted gap counts as closed (0 unless grouted)
-            gap0: n.dot(&xbar0) - pr.gap_offset,
+            // the grouted gap and a held re-entry penetration count as closed (0 unless so)
+            gap0: n.dot(&xbar0) - pr.gap_offset - pr.entry_offset,
             rel_u,
             joint: ji as u32,
             pair: i as u32,
@@ -1784,10 +1800,18 @@ fn list_pairs_into<const N: usize>(active: &mut [Active<N>], node: &mut [NodeScr
 fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, local: &[LocalNode], u_prev: &[f64]) -> f64 {
     let i = a.pair as usize;
     let [n, t1, t2] = a.frame;
-    let p = &mut history.joints[a.joint as usize].pairs[i];
+    let rec = &mut history.joints[a.joint as usize];
+    let p = &mut rec.pairs[i];
+    // lost in the step before (no face, gap NaN): this step is its re-entry
+    let reentry = p.gap.is_nan();
     p.hist = a.hist;
     p.state = a.state;
     p.gap = a.gap;
+    // a held re-entry penetration is released as far as the node moved out (a.gap counts it
+    // as closed: the geometric gap is a.gap + entry_offset); never deepened
+    if p.entry_offset < 0.0 {
+        p.entry_offset = (p.gap + p.entry_offset).max(p.entry_offset).min(0.0);
+    }
     p.r_n = a.r_n;
     p.r_t = [a.r_t.x, a.r_t.y];
     // accumulated tangential relative displacement over the step, from the final
@@ -1806,7 +1830,13 @@ fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, l
     // ½ (x[n+1] − x[n−1]) of the slave relative to the master point
     let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
     let du = (rel_prev - rel) * 0.5;
-    rvec.dot(&du)
+    let work = rvec.dot(&du);
+    rec.work += work;
+    if reentry {
+        rec.reentries += 1;
+        rec.reentry_work += work.max(0.0);
+    }
+    work
 }
 
 impl Constraint<ContactState> for ContactSolver<'_> {

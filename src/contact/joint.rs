@@ -7,7 +7,7 @@ use crate::error::{Error, ModelError};
 use crate::interface::{tag_joint_in, Joint, JointSpec};
 use crate::mesh::topology::Blocks;
 use crate::mesh::Mesh;
-use crate::scene::{ContactMethod, JointSceneSpec, OnExitSpec, Scene};
+use crate::scene::{ContactMethod, JointSceneSpec, OnExitSpec, ReentrySpec, Scene};
 use nalgebra::Vector3;
 
 pub use super::query::tangent_frame;
@@ -49,6 +49,9 @@ pub struct ContactJoint {
     pub on_exit: OnExit,
     /// Inside-test tolerance, fraction of the face size (see the scene field `edge_tolerance`).
     pub edge_tolerance: f64,
+    /// Hold a re-entering node's penetration as closed instead of pushing it out (the scene
+    /// field `reentry`: "hold" true, "push" false).
+    pub hold_reentry: bool,
     /// Local frame (n, t1, t2) per slave node; n is the tagger's slave normal.
     pub frames: Vec<[Vector3<f64>; 3]>,
 }
@@ -109,7 +112,8 @@ impl ContactJoint {
                 [n, t1, t2]
             })
             .collect();
-        Ok(ContactJoint { tag, law, method, layer, on_exit, edge_tolerance, frames })
+        let hold_reentry = spec.reentry == Some(ReentrySpec::Hold);
+        Ok(ContactJoint { tag, law, method, layer, on_exit, edge_tolerance, hold_reentry, frames })
     }
 }
 

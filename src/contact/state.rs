@@ -28,6 +28,11 @@ pub struct PairRecord {
     /// unless the joint was grouted, where it is the gap at grouting (a construction
     /// sequence's stage, `construction`), so the grouted joint starts closed with no force.
     pub gap_offset: f64,
+    /// Penetration held as closed since the node's re-entry [m], ≤ 0, also subtracted from the
+    /// gap: 0 unless the joint holds re-entries (`ContactJoint::hold_reentry`), where a node
+    /// that finds a face after a lost step takes its predicted gap then (if negative) and
+    /// releases it as it moves out (it never deepens; 0 again when the node is lost).
+    pub entry_offset: f64,
     /// Whether the node, lost in the last step (gap NaN), lay beyond the master surface's free
     /// edge (`super::free_edge`: it slid off the surface) rather than inside its outline; false
     /// while it finds a face. Its travel then counts as no penetration in the outputs.
@@ -90,6 +95,19 @@ pub struct JointRecord {
     pub max_gs_residual: f64,
     /// That worst step: when, and the node its last sweep moved most (None if none).
     pub worst_cap: Option<CapStep>,
+    /// Cumulative work of the joint's dynamic-force pair forces since the clock's start [J]
+    /// (the joint's share of `Energy::contact_work`: each pair's force on the central-difference
+    /// increment of its slave relative to its master point). Friction and plastic closure make
+    /// it negative; a positive trend is energy the joint creates.
+    pub work: f64,
+    /// Re-entries: pair-steps in which a slave node lost in the step before (no master face,
+    /// gap NaN) found a face and took a force (also each pair's first step of a run without a
+    /// static stage: no gap before it). A node that travelled into the master while lost
+    /// is pushed back out in that one step, with a relative velocity of its penetration / dt.
+    pub reentries: u64,
+    /// The positive part of those pairs' work in their re-entry step, summed [J]: the energy
+    /// re-entries created (a re-entry that closes no penetration does no positive work).
+    pub reentry_work: f64,
 }
 
 /// The step whose Gauss–Seidel stopped at the sweep budget with the largest residual: what a
@@ -150,6 +168,7 @@ impl ContactState {
                             d_t: [0.0; 2],
                             slip: 0.0,
                             gap_offset: 0.0,
+                            entry_offset: 0.0,
                             beyond_edge: false,
                         })
                         .collect(),
@@ -161,7 +180,7 @@ impl ContactState {
 }
 
 impl ContactState {
-    /// Restart the joints' slip counters from the current state (after gravity equilibrium:
+    /// Restart the joints' slip and work counters from the current state (after gravity equilibrium:
     /// slip while settling is not seismic slip, and the softening of a bond counts the slip of
     /// the earthquake, not of settling).
     pub fn restart_slip(&mut self) {
@@ -171,6 +190,9 @@ impl ContactState {
                 p.d_t = [0.0; 2];
                 p.hist.slip = 0.0;
             }
+            r.work = 0.0;
+            r.reentries = 0;
+            r.reentry_work = 0.0;
         }
     }
 }

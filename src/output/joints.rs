@@ -67,12 +67,22 @@ pub struct JointPeaks {
     /// Typical slave face size √(slave area / faces) [m] (the scale of the NTN warning).
     #[serde(default)]
     pub face_size: f64,
+    /// The joint's contact work over the run [J], its re-entries and their positive work [J]
+    /// (`contact::state::JointRecord::work`, `reentries`, `reentry_work`).
+    #[serde(default)]
+    pub contact_work: f64,
+    #[serde(default)]
+    pub reentries: u64,
+    #[serde(default)]
+    pub reentry_work: f64,
 }
 
 /// Header of `histories/joint_<joint>.csv`: maxima over the slave nodes [m], the pairs per
 /// state (`open` counts the lost ones too), the step's Gauss–Seidel sweeps, the summed normal
-/// (compressive) and |tangential| force [N], the lost pairs and their largest `lost_travel` [m].
-pub const JOINT_HEADER: &str = "t [s],max_opening [m],max_slip [m],max_tangential_displacement [m],max_penetration [m],open,stick,slip,bonded,sweeps,normal_force [N],shear_force [N],lost,max_lost_travel [m]";
+/// (compressive) and |tangential| force [N], the lost pairs and their largest `lost_travel` [m];
+/// then, cumulative since the clock's start, the joint's contact work [J], its re-entries and
+/// their positive work [J] (`JointRecord::work`, `reentries`, `reentry_work`).
+pub const JOINT_HEADER: &str = "t [s],max_opening [m],max_slip [m],max_tangential_displacement [m],max_penetration [m],open,stick,slip,bonded,sweeps,normal_force [N],shear_force [N],lost,max_lost_travel [m],contact_work [J],reentries,reentry_work [J]";
 
 /// The codes of the joint series' `state` array and their names (its FieldData labels).
 pub const STATE_LABELS: [(&str, i32); 4] = [("state_label_open", 0), ("state_label_stick", 1), ("state_label_slip", 2), ("state_label_bonded", 3)];
@@ -230,7 +240,8 @@ impl JointWriter {
             for p in &r.pairs {
                 if p.gap.is_finite() {
                     mo = mo.max(p.gap);
-                    mp = mp.max(-p.gap);
+                    // a held re-entry penetration is penetration too
+                    mp = mp.max(-p.gap).max(-p.entry_offset);
                 }
                 ms = ms.max(p.slip);
                 md = md.max((p.d_t[0] * p.d_t[0] + p.d_t[1] * p.d_t[1]).sqrt());
@@ -251,8 +262,9 @@ impl JointWriter {
             pk.worst_cap.clone_from(&r.worst_cap);
             pk.events = r.events.clone();
             pk.max_lost_travel = pk.max_lost_travel.max(ml);
+            (pk.contact_work, pk.reentries, pk.reentry_work) = (r.work, r.reentries, r.reentry_work);
             let c = state_counts(r);
-            let _ = writeln!(self.csv[k].buf(), "{t:.9e},{mo:.9e},{ms:.9e},{md:.9e},{mp:.9e},{},{},{},{},{},{fn_:.9e},{ft:.9e},{lost},{ml:.9e}", c[0], c[1], c[2], c[3], r.sweeps);
+            let _ = writeln!(self.csv[k].buf(), "{t:.9e},{mo:.9e},{ms:.9e},{md:.9e},{mp:.9e},{},{},{},{},{},{fn_:.9e},{ft:.9e},{lost},{ml:.9e},{:.9e},{},{:.9e}", c[0], c[1], c[2], c[3], r.sweeps, r.work, r.reentries, r.reentry_work);
             if let Some((w, was_closed)) = self.forces.get_mut(k) {
                 let row = force_row(j, r, was_closed);
                 let _ = writeln!(w.buf(), "{t:.9e},{row}");

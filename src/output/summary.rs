@@ -260,6 +260,9 @@ impl RunSummary {
                     j.ntn_max_distance, 100.0 * j.ntn_max_distance / j.face_size.max(f64::MIN_POSITIVE), j.face_size
                 );
             }
+            if j.reentries > 0 {
+                let _ = writeln!(s, "                 {} re-entries after lost steps, {:.3e} J of positive work (joint's contact work {:.3e} J)", j.reentries, j.reentry_work, j.contact_work);
+            }
             if j.max_lost_travel > 0.0 {
                 let _ = writeln!(s, "                 lost nodes travelled up to {:.3e} m off their last master node", j.max_lost_travel);
             }

@@ -762,6 +762,17 @@ pub struct JointSceneSpec {
     /// 1e-3 h is above elastic lateral mismatches of rock and concrete joints (strain ≤ 1e-3).
     #[serde(default)]
     pub edge_tolerance: Option<f64>,
+    /// A slave node that finds a master face again after a step lost (its *re-entry*), with a
+    /// penetration it took while lost (it slid back over the master's free edge after the
+    /// joint closed, or was lost inside the outline): `"push"` (default) closes it in that one
+    /// step, as every contact step does, and so gives the node a relative velocity of
+    /// penetration / dt, energy the joint creates (the joint histories' `reentry_work`);
+    /// `"hold"` takes that penetration as closed and releases it as the node moves out (it
+    /// never deepens), so a re-entry creates no energy, the treatment of initial penetrations
+    /// of LS-DYNA's contacts (IGNORE) and Abaqus' strain-free adjustment. Default "push": the
+    /// seed's dynamic contact force, whose results the committed studies hold.
+    #[serde(default)]
+    pub reentry: Option<ReentrySpec>,
     /// Penalty stiffness per unit area [Pa/m] for method "penalty".
     #[serde(default)]
     pub penalty_stiffness: Option<f64>,
@@ -813,6 +824,14 @@ impl std::str::FromStr for ContactMethod {
 pub enum OnExitSpec {
     Widen,
     Report,
+}
+
+/// What a re-entering slave node's penetration does (`"push"`, `"hold"`: `JointSceneSpec::reentry`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ReentrySpec {
+    Push,
+    Hold,
 }
 
 /// Friction coefficient of a joint that gives neither `mu` nor `phi`. Default 0.6 (φ ≈ 31°, the
