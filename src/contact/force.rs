@@ -1059,6 +1059,10 @@ impl ContactSolver<'_> {
             let i = first + k;
             let s = j.tag.slave_nodes()[i];
             let xs = pos(model, conf, s);
+            // lost in the step before (searched, no gap): finding a face now is a re-entry
+            let was_lost = pr.searched && pr.gap.is_nan();
+            pr.searched = true;
+            pr.reentered = false;
             let pm = match j.method {
                 Method::Ntn => PairMasters { nodes: [j.tag.nearest_master_node(i) as u32, 0, 0, 0], nm: 1, weights: [1.0, 0.0, 0.0, 0.0], face: -1 },
                 _ => match Self::nts_face_into(model, j, pr, ev, cand, i, &xs, conf) {
@@ -1083,7 +1087,8 @@ impl ContactSolver<'_> {
                 continue;
             }
             let Some(mobility) = self.pair_mobility(model, s, &j.frames[i][0], &pm) else { continue };
-            if j.hold_reentry && pr.gap.is_nan() && !matches!(j.method, Method::Penalty { .. }) {
+            pr.reentered = was_lost && !matches!(j.method, Method::Penalty { .. });
+            if j.hold_reentry && pr.reentered {
                 // re-entry: its predicted penetration counts as closed (`PairRecord::entry_offset`)
                 pr.entry_offset = predicted_gap(model, j, pr, i, &pm, conf).min(0.0);
             }
@@ -1802,8 +1807,7 @@ fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, l
     let [n, t1, t2] = a.frame;
     let rec = &mut history.joints[a.joint as usize];
     let p = &mut rec.pairs[i];
-    // lost in the step before (no face, gap NaN): this step is its re-entry
-    let reentry = p.gap.is_nan();
+    let reentry = p.reentered;
     p.hist = a.hist;
     p.state = a.state;
     p.gap = a.gap;

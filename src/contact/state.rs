@@ -33,6 +33,12 @@ pub struct PairRecord {
     /// that finds a face after a lost step takes its predicted gap then (if negative) and
     /// releases it as it moves out (it never deepens; 0 again when the node is lost).
     pub entry_offset: f64,
+    /// Whether the node has been searched once (false in the state a run starts from, whose
+    /// NaN gap means "not searched yet", not "lost").
+    pub searched: bool,
+    /// Whether this step is the node's re-entry: it found a face after a lost step (set by the
+    /// search, read by the record; NTS and NTN joints).
+    pub reentered: bool,
     /// Whether the node, lost in the last step (gap NaN), lay beyond the master surface's free
     /// edge (`super::free_edge`: it slid off the surface) rather than inside its outline; false
     /// while it finds a face. Its travel then counts as no penetration in the outputs.
@@ -100,9 +106,8 @@ pub struct JointRecord {
     /// increment of its slave relative to its master point). Friction and plastic closure make
     /// it negative; a positive trend is energy the joint creates.
     pub work: f64,
-    /// Re-entries: pair-steps in which a slave node lost in the step before (no master face,
-    /// gap NaN) found a face and took a force (also each pair's first step of a run without a
-    /// static stage: no gap before it). A node that travelled into the master while lost
+    /// Re-entries: pair-steps in which a slave node lost in the step before (no master face)
+    /// found a face again (NTS and NTN joints). A node that travelled into the master while lost
     /// is pushed back out in that one step, with a relative velocity of its penetration / dt.
     pub reentries: u64,
     /// The positive part of those pairs' work in their re-entry step, summed [J]: the energy
@@ -169,6 +174,8 @@ impl ContactState {
                             slip: 0.0,
                             gap_offset: 0.0,
                             entry_offset: 0.0,
+                            searched: false,
+                            reentered: false,
                             beyond_edge: false,
                         })
                         .collect(),
