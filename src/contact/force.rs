@@ -51,6 +51,7 @@
 use super::free_edge;
 use super::joint::{ContactJoint, Method, OnExit};
 use super::law::{pair_force_with_inverse, penalty_force, JointLaw, PairHistory, PairState};
+use super::state::released_entry_offset;
 pub use super::state::{ContactState, JointRecord, PairRecord, SearchEvents};
 use super::mortar::{overlap_integrals, Overlap, SlaveFace};
 use super::query::{project_along_on_quad_from, project_along_on_tri, select_projection, Location, INSIDE_TOL_DEFAULT};
@@ -1811,11 +1812,7 @@ fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, l
     p.hist = a.hist;
     p.state = a.state;
     p.gap = a.gap;
-    // a held re-entry penetration is released as far as the node moved out (a.gap counts it
-    // as closed: the geometric gap is a.gap + entry_offset); never deepened
-    if p.entry_offset < 0.0 {
-        p.entry_offset = (p.gap + p.entry_offset).max(p.entry_offset).min(0.0);
-    }
+    p.entry_offset = released_entry_offset(p.entry_offset, p.gap);
     p.r_n = a.r_n;
     p.r_t = [a.r_t.x, a.r_t.y];
     // accumulated tangential relative displacement over the step, from the final

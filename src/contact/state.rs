@@ -45,6 +45,17 @@ pub struct PairRecord {
     pub beyond_edge: bool,
 }
 
+/// A held re-entry penetration after a step (`PairRecord::entry_offset`, ≤ 0 [m]) whose gap,
+/// counting the offset as closed, ended at `gap` [m]: released as far as the node moved out
+/// (the geometric gap is `gap + offset`), never deepened, 0 once the node is out. A NaN gap (the
+/// node lost again) releases it all.
+pub fn released_entry_offset(offset: f64, gap: f64) -> f64 {
+    if !(offset < 0.0) || gap.is_nan() {
+        return 0.0;
+    }
+    (gap + offset).max(offset).min(0.0)
+}
+
 /// Counters of search events per joint.
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SearchEvents {
@@ -207,6 +218,20 @@ impl ContactState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The hold of a re-entry (docs/contact.md, "Re-entry"): a node held 40 mm deep keeps it
+    /// while it stays closed or is pushed further in (never deepened), is released by what it
+    /// moves out (10 mm out: held 30 mm), is free once out by more than the hold, and a lost
+    /// node holds nothing. Exact arithmetic on these values.
+    #[test]
+    fn a_held_reentry_penetration_is_released_as_the_node_moves_out_and_never_deepened() {
+        assert_eq!(released_entry_offset(-0.04, 0.0), -0.04);
+        assert_eq!(released_entry_offset(-0.04, -0.01), -0.04);
+        assert!((released_entry_offset(-0.04, 0.01) - -0.03).abs() < 1e-15);
+        assert_eq!(released_entry_offset(-0.04, 0.05), 0.0);
+        assert_eq!(released_entry_offset(-0.04, f64::NAN), 0.0);
+        assert_eq!(released_entry_offset(0.0, -0.02), 0.0);
+    }
 
     /// The wedge demo's Gauss–Seidel warning (issue 32 §4): the unconverged steps of the 1.0 g
     /// wedge were all at slave nodes shared by joints A and B (its line of intersection), whose
