@@ -105,7 +105,8 @@ pub struct Provenance {
     /// jointquake's version (Cargo.toml).
     pub version: String,
     /// The git commit jointquake was built from (`git rev-parse HEAD` at build time, build.rs),
-    /// "unknown" when built outside a git checkout.
+    /// with `-dirty` when its sources differ from that commit, "unknown" when built outside a
+    /// git checkout.
     pub commit: String,
     /// The Slurm job that ran it, when run under Slurm.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -137,8 +137,14 @@ fn run_summary_records_host_build_and_slurm_ids_and_old_summaries_still_read() {
     let commit = p["commit"].as_str().unwrap();
     match git(&["rev-parse", "HEAD"]) {
         Some(_) => {
-            assert!(commit.len() == 40 && commit.bytes().all(|b| b.is_ascii_hexdigit()), "commit {commit}");
-            assert_eq!(git(&["cat-file", "-t", commit]).as_deref(), Some("commit"), "{commit} is not a commit of this repository");
+            // "-dirty" when built from uncommitted sources (build.rs)
+            let sha = commit.strip_suffix("-dirty").unwrap_or(commit);
+            assert!(sha.len() == 40 && sha.bytes().all(|b| b.is_ascii_hexdigit()), "commit {commit}");
+            assert_eq!(git(&["cat-file", "-t", sha]).as_deref(), Some("commit"), "{sha} is not a commit of this repository");
+            let dirty = git(&["status", "--porcelain", "--", "src", "build.rs", "Cargo.toml", "Cargo.lock"]).is_some_and(|s| !s.is_empty());
+            if !dirty {
+                assert!(!commit.ends_with("-dirty"), "clean sources, yet {commit}");
+            }
         }
         None => assert_eq!(commit, "unknown"),
     }
