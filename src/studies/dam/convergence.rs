@@ -68,30 +68,45 @@ pub struct Extrapolation {
     /// Absolute error band around `finest` (the GCI); `None` with one mesh.
     pub band: Option<f64>,
     pub behaviour: Behaviour,
+    /// With four meshes or more, how the three next-coarser meshes behaved (the same rule one
+    /// mesh coarser; `None` with fewer): information beside the finest three's extrapolation,
+    /// which it does not change. A finest triplet that converges while the coarser one
+    /// oscillates (the dam's NTS 3× opening: +17, −51, −3 mm) is read as "the two finest agree
+    /// to their last change", not as a verified order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coarser: Option<Behaviour>,
 }
 
 /// Observed order, extrapolated value and error band from `(h, value)` per mesh, in any order
-/// (sorted by h here; the three finest are used). Sizes must be positive and distinct.
+/// (sorted by h here; the three finest are used, and with four or more the three next-coarser
+/// give [`Extrapolation::coarser`]). Sizes must be positive and distinct.
 pub fn richardson(points: &[(f64, f64)]) -> Extrapolation {
     let mut p: Vec<(f64, f64)> = points.iter().copied().filter(|(h, v)| *h > 0.0 && v.is_finite()).collect();
     p.sort_by(|a, b| a.0.total_cmp(&b.0));
     p.dedup_by(|a, b| a.0 == b.0);
+    let coarser = (p.len() >= 4).then(|| richardson_finest_three(&p[1..]).behaviour);
+    Extrapolation { coarser, ..richardson_finest_three(&p) }
+}
+
+/// [`richardson`] on `p`, sorted finest first without repeats: the three finest only.
+fn richardson_finest_three(p: &[(f64, f64)]) -> Extrapolation {
     let unverified = |phi1: f64, changes: &[f64], behaviour: Behaviour| Extrapolation {
         finest: phi1,
         order: None,
         extrapolated: phi1,
         band: Some(SAFETY_UNVERIFIED * changes.iter().fold(0.0f64, |a, c| a.max(c.abs()))),
         behaviour,
+        coarser: None,
     };
     match p.len() {
-        0 => Extrapolation { finest: f64::NAN, order: None, extrapolated: f64::NAN, band: None, behaviour: Behaviour::OneMesh },
-        1 => Extrapolation { finest: p[0].1, order: None, extrapolated: p[0].1, band: None, behaviour: Behaviour::OneMesh },
+        0 => Extrapolation { finest: f64::NAN, order: None, extrapolated: f64::NAN, band: None, behaviour: Behaviour::OneMesh, coarser: None },
+        1 => Extrapolation { finest: p[0].1, order: None, extrapolated: p[0].1, band: None, behaviour: Behaviour::OneMesh, coarser: None },
         2 => unverified(p[0].1, &[p[1].1 - p[0].1], Behaviour::TwoMeshes),
         _ => {
             let ((h1, f1), (h2, f2), (h3, f3)) = (p[0], p[1], p[2]);
             let (e21, e32) = (f2 - f1, f3 - f2);
             if e21 == 0.0 && e32 == 0.0 {
-                return Extrapolation { finest: f1, order: None, extrapolated: f1, band: Some(0.0), behaviour: Behaviour::Converging };
+                return Extrapolation { finest: f1, order: None, extrapolated: f1, band: Some(0.0), behaviour: Behaviour::Converging, coarser: None };
             }
             if e21 == 0.0 || e32 / e21 < 0.0 {
                 return unverified(f1, &[e21, e32], Behaviour::Oscillating);
@@ -118,7 +133,7 @@ pub fn richardson(points: &[(f64, f64)]) -> Extrapolation {
                 return unverified(f1, &[e21, e32], Behaviour::OrderOutOfRange);
             }
             let rp = r21.powf(order);
-            Extrapolation { finest: f1, order: Some(order), extrapolated: (rp * f1 - f2) / (rp - 1.0), band: Some(SAFETY_OBSERVED * e21.abs() / (rp - 1.0)), behaviour: Behaviour::Converging }
+            Extrapolation { finest: f1, order: Some(order), extrapolated: (rp * f1 - f2) / (rp - 1.0), band: Some(SAFETY_OBSERVED * e21.abs() / (rp - 1.0)), behaviour: Behaviour::Converging, coarser: None }
         }
     }
 }
@@ -198,6 +213,15 @@ mod tests {
         assert!((e.order.unwrap() - 2.0).abs() < 1e-10, "{e:?}");
         assert!((e.extrapolated - 10.0).abs() < 1e-10, "{e:?}");
         assert!((e.band.unwrap() - 1.25 * 9.0 / 3.0).abs() < 1e-10, "{e:?}");
+        // the coarser three (h = 2, 4, 8) converge at the same order
+        assert_eq!(e.coarser, Some(Behaviour::Converging));
+        // the dam's NTS 3× largest opening [mm] (coarse 20 m to h 2.5 m): the finest three
+        // converge (p ≈ 3.96, inside [0.5, 4]), the coarser three oscillate; that is recorded
+        // beside the extrapolation, which it does not change
+        let e = richardson(&[(20.0, 256.0), (10.0, 273.0), (5.0, 222.0), (2.5, 218.7)]);
+        assert_eq!((e.behaviour, e.coarser), (Behaviour::Converging, Some(Behaviour::Oscillating)), "{e:?}");
+        assert!((e.order.unwrap() - 3.95).abs() < 0.05, "{e:?}");
+        assert_eq!(richardson(&[(1.0, f(1.0)), (2.0, f(2.0)), (4.0, f(4.0))]).coarser, None);
         assert!((e.extrapolated - e.finest).abs() <= e.band.unwrap());
     }
 

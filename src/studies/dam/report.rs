@@ -722,7 +722,7 @@ fn reference_section(r: &DamReport, doc: &mut Doc) {
             v.method.name().into(),
             v.quantity.name().0.into(),
             v.values.iter().map(|m| f(m.value)).collect::<Vec<_>>().join(" / "),
-            format!("{:?}{}", e.behaviour, e.order.map_or(String::new(), |p| format!(", p = {}", fmt_sig(p, 3)))),
+            format!("{:?}{}{}", e.behaviour, e.order.map_or(String::new(), |p| format!(", p = {}", fmt_sig(p, 3))), e.coarser.map_or(String::new(), |c| format!("; coarser three: {c:?}"))),
             format!("{} ± {}", f(e.extrapolated), e.band.map_or("–".into(), f)),
         ]);
     }
