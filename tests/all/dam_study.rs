@@ -364,7 +364,7 @@ fn dam_study_small_nts_and_ntn_agree_at_small_input_and_the_report_is_filled_fro
         method,
         level: 0.1,
         values: vec![MeshValue { mesh: "coarse".into(), h: 20.0, value: v + band / 3.0 }, MeshValue { mesh: "default".into(), h: 10.0, value: v }],
-        extrapolation: Extrapolation { finest: v, order: None, extrapolated: v, band: Some(band), behaviour: Behaviour::TwoMeshes, coarser: None },
+        extrapolation: Extrapolation { finest: v, order: None, extrapolated: v, band: Some(band), behaviour: Behaviour::TwoMeshes, coarser: None, least_squares: None },
     };
     let reference = DamReference {
         study: "hand-made".into(),

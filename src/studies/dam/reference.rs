@@ -205,7 +205,8 @@ impl DamReference {
             0 => "no finished NTS or NTN run".to_string(),
             1 => "one mesh: no error band".to_string(),
             2 => format!("two meshes ({}): no observed order; value = the finer mesh's, band = 3 × the change between them (Roache's factor for an unverified order)", meshes.iter().map(|m| format!("{} h {} m", m.label, m.h)).collect::<Vec<_>>().join(", ")),
-            _ => "three or more meshes: Richardson extrapolation from the three finest (Celik et al. 2008), band = GCI with safety factor 1.25; 3 × the largest change where the order is not observed".to_string(),
+            3 => "three meshes: Richardson extrapolation (Celik et al. 2008), band = GCI with safety factor 1.25; 3 × the largest change where the order is not observed".to_string(),
+            _ => "three or more meshes: Richardson extrapolation from the three finest (Celik et al. 2008), band = GCI with safety factor 1.25, 3 × the largest change where the order is not observed; where a quantity has four meshes or more, the band is the larger of that and the least-squares uncertainty U over all of them (Eça & Hoekstra 2014)".to_string(),
         };
         Ok(DamReference { study: study.into(), commits, meshes, note, values })
     }

@@ -709,7 +709,7 @@ fn reference_section(r: &DamReport, doc: &mut Doc) {
         rf.meshes.iter().map(|m| format!("{} (h {} m)", m.label, fmt_sig(m.h, 3))).collect::<Vec<_>>().join(", "),
         rf.note
     );
-    let mut t = Table::new(["level", "method", "quantity", "per mesh (coarsest first)", "behaviour, order", "value ± band"]);
+    let mut t = Table::new(["level", "method", "quantity", "per mesh (coarsest first)", "finest three: behaviour, order, band", "least squares, four meshes or more: fit, p, φ0, U", "value ± band"]);
     for v in &rf.values {
         let f = |x: f64| match v.unit.as_str() {
             "Pa" => format!("{} MPa", mpa(x)),
@@ -722,7 +722,14 @@ fn reference_section(r: &DamReport, doc: &mut Doc) {
             v.method.name().into(),
             v.quantity.name().0.into(),
             v.values.iter().map(|m| f(m.value)).collect::<Vec<_>>().join(" / "),
-            format!("{:?}{}{}", e.behaviour, e.order.map_or(String::new(), |p| format!(", p = {}", fmt_sig(p, 3))), e.coarser.map_or(String::new(), |c| format!("; coarser three: {c:?}"))),
+            format!(
+                "{:?}{}{}{}",
+                e.behaviour,
+                e.order.map_or(String::new(), |p| format!(", p = {}", fmt_sig(p, 3))),
+                e.least_squares.as_ref().and_then(|l| l.finest_three_band).map_or(String::new(), |b| format!(", ± {}", f(b))),
+                e.coarser.map_or(String::new(), |c| format!("; coarser three: {c:?}"))
+            ),
+            e.least_squares.as_ref().map_or("–".into(), |l| format!("{}, {}, {} ± {} (F_s {})", l.fit.label(), l.order_text(), f(l.extrapolated), f(l.uncertainty), l.safety)),
             format!("{} ± {}", f(e.extrapolated), e.band.map_or("–".into(), f)),
         ]);
     }
