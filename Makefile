@@ -178,8 +178,8 @@ dam-coarse:
 # pipelines/dam_reference.json that `make dam`'s report reads. Not run whole here: each h 2.5 m
 # NTS run takes about 1 h 10 min on 2 threads of a quiet machine and 12.8 GB (74 322 steps; NTS at
 # 3x measured: 828 s static, 3386 s dynamic; docs/dam.md, "The h 2.5 m runs"); each NTN one an
-# estimated 2.5-3 h (its static state needs 4-10x NTS's Newton iterations and its steps cost
-# 1.9x: docs/performance.md, "NTN's static state"). The NTS runs hold
+# estimated 1.5-2 h (its static state needs 4-10x NTS's Newton iterations; its steps cost 0.7x
+# NTS's: docs/performance.md, "NTN's static state"). The NTS runs hold
 # their re-entry penetrations (`reentry: "hold"`): pushed out, they stopped the h 2.5 m NTS 3x
 # run at t = 4.24 s (docs/contact.md, "Re-entry").
 # DAM_CONVERGENCE=pipelines/dam_convergence_affordable_study.json: coarse and default only
