@@ -174,10 +174,7 @@ pub fn richardson(points: &[(f64, f64)]) -> Extrapolation {
     p.sort_by(|a, b| a.0.total_cmp(&b.0));
     p.dedup_by(|a, b| a.0 == b.0);
     let three = richardson_finest_three(&p);
-    if p.len() < 4 {
-        return three;
-    }
-    let ls = least_squares(&p);
+    let Some(ls) = least_squares(&p) else { return three };
     let band = three.band.map(|b| b.max(ls.uncertainty));
     let coarser = Some(richardson_finest_three(&p[1..]).behaviour);
     Extrapolation { coarser, band, least_squares: Some(LeastSquares { finest_three_band: three.band, ..ls }), ..three }
@@ -218,8 +215,12 @@ fn free_order(p: &[(f64, f64)]) -> f64 {
 }
 
 /// The least-squares uncertainty of Eça & Hoekstra (2014) from `p` (sorted finest first,
-/// distinct sizes, four or more); `finest_three_band` is left `None` for the caller.
-pub fn least_squares(p: &[(f64, f64)]) -> LeastSquares {
+/// distinct sizes); `None` with fewer than four meshes (the h + h² fit then has no σ);
+/// `finest_three_band` is left `None` for the caller.
+pub fn least_squares(p: &[(f64, f64)]) -> Option<LeastSquares> {
+    if p.len() < 4 {
+        return None;
+    }
     let phi1 = p[0].1;
     let (lo, hi) = p.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), x| (l.min(x.1), h.max(x.1)));
     let data_range = (hi - lo) / (p.len() - 1) as f64;
@@ -238,7 +239,7 @@ pub fn least_squares(p: &[(f64, f64)]) -> LeastSquares {
         .min_by(|a, b| a.1 .2.total_cmp(&b.1 .2));
     let Some((fit, (phi0, at1, sigma, _))) = chosen else {
         // unreachable with four distinct sizes; kept as the unverified rule, not a panic
-        return LeastSquares { order, fit: Fit::FreeOrder, extrapolated: phi1, sigma: f64::NAN, data_range, safety: SAFETY_UNVERIFIED, uncertainty: SAFETY_UNVERIFIED * (hi - lo), finest_three_band: None };
+        return Some(LeastSquares { order, fit: Fit::FreeOrder, extrapolated: phi1, sigma: f64::NAN, data_range, safety: SAFETY_UNVERIFIED, uncertainty: SAFETY_UNVERIFIED * (hi - lo), finest_three_band: None });
     };
     let (eps, dev) = ((phi1 - phi0).abs(), (phi1 - at1).abs());
     let uncertainty = if data_range == 0.0 {
@@ -248,7 +249,7 @@ pub fn least_squares(p: &[(f64, f64)]) -> LeastSquares {
     } else {
         3.0 * sigma / data_range * (eps + sigma + dev)
     };
-    LeastSquares { order, fit, extrapolated: phi0, sigma, data_range, safety, uncertainty, finest_three_band: None }
+    Some(LeastSquares { order, fit, extrapolated: phi0, sigma, data_range, safety, uncertainty, finest_three_band: None })
 }
 
 /// [`richardson`] on `p`, sorted finest first without repeats: the three finest only.
@@ -410,7 +411,7 @@ mod tests {
         // may serve, with F_s = 1.25; they cannot follow h³ (σ ≥ 1), so U (58, from the same
         // rule in numpy) must cover the true error |φ1 − 10| = 1 many times
         let f = |h: f64| 10.0 + h.powi(3);
-        let ls = least_squares(&[(1.0, f(1.0)), (2.0, f(2.0)), (4.0, f(4.0)), (8.0, f(8.0))]);
+        let ls = least_squares(&[(1.0, f(1.0)), (2.0, f(2.0)), (4.0, f(4.0)), (8.0, f(8.0))]).unwrap();
         assert!((ls.order - 3.0).abs() < 1e-3 && ls.safety == SAFETY_OBSERVED, "{ls:?}");
         assert!(matches!(ls.fit, Fit::Second | Fit::FirstAndSecond) && ls.uncertainty > 10.0, "{ls:?}");
         // the dam's NTS 3× largest opening [mm], coarse 20 m to h 2.5 m: not monotone, so the
@@ -424,8 +425,11 @@ mod tests {
         assert!((ls.uncertainty / 138.30 - 1.0).abs() < 1e-3 && e.band == Some(ls.uncertainty), "{e:?}");
         assert!(ls.finest_three_band.unwrap() < 0.3, "{ls:?}");
         // constant values: no uncertainty
-        let ls = least_squares(&[(1.0, 5.0), (2.0, 5.0), (4.0, 5.0), (8.0, 5.0)]);
+        let ls = least_squares(&[(1.0, 5.0), (2.0, 5.0), (4.0, 5.0), (8.0, 5.0)]).unwrap();
         assert_eq!(ls.uncertainty, 0.0, "{ls:?}");
+        // fewer than four meshes (or none): no least-squares estimate, no panic
+        assert_eq!(least_squares(&[(1.0, 5.0), (2.0, 6.0), (4.0, 8.0)]), None);
+        assert_eq!(least_squares(&[]), None);
     }
 
     #[test]
