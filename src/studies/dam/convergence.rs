@@ -88,7 +88,9 @@ pub struct Extrapolation {
     pub order: Option<f64>,
     /// φ_ext (φ1 when no order).
     pub extrapolated: f64,
-    /// Absolute error band around `finest` (the GCI); `None` with one mesh.
+    /// Absolute error band around `finest`: the finest three's (the GCI, or 3 × the largest
+    /// change without an order), with four meshes or more the larger of that and the
+    /// least-squares U ([`Extrapolation::least_squares`]); `None` with one mesh.
     pub band: Option<f64>,
     pub behaviour: Behaviour,
     /// With four meshes or more, how the three next-coarser meshes behaved (the same rule one
@@ -102,21 +104,6 @@ pub struct Extrapolation {
     /// `band` is then the larger of its uncertainty and the finest three's band.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub least_squares: Option<LeastSquares>,
-}
-
-impl LeastSquares {
-    /// The free order as the report writes it: "p = 1.52", or "p ≤ 0.05" / "p ≥ 8" at the
-    /// search's bounds (the sum of squares still falling there).
-    pub fn order_text(&self) -> String {
-        let (lo, hi) = LS_ORDER_SEARCH;
-        if self.order <= lo * 1.001 {
-            format!("p ≤ {lo}")
-        } else if self.order >= hi * 0.999 {
-            format!("p ≥ {hi}")
-        } else {
-            format!("p = {:.3}", self.order)
-        }
-    }
 }
 
 /// Which least-squares fit an uncertainty came from.
@@ -166,6 +153,21 @@ pub struct LeastSquares {
     pub finest_three_band: Option<f64>,
 }
 
+impl LeastSquares {
+    /// The free order as the report writes it: "p = 1.52", or "p ≤ 0.05" / "p ≥ 8" at the
+    /// search's bounds (the sum of squares still falling there).
+    pub fn order_text(&self) -> String {
+        let (lo, hi) = LS_ORDER_SEARCH;
+        if self.order <= lo * 1.001 {
+            format!("p ≤ {lo}")
+        } else if self.order >= hi * 0.999 {
+            format!("p ≥ {hi}")
+        } else {
+            format!("p = {:.3}", self.order)
+        }
+    }
+}
+
 /// Observed order, extrapolated value and error band from `(h, value)` per mesh, in any order
 /// (sorted by h here; the three finest are used, and with four or more the three next-coarser
 /// give [`Extrapolation::coarser`]). Sizes must be positive and distinct.
@@ -180,9 +182,19 @@ pub fn richardson(points: &[(f64, f64)]) -> Extrapolation {
     Extrapolation { coarser, band, least_squares: Some(LeastSquares { finest_three_band: three.band, ..ls }), ..three }
 }
 
-/// One least-squares fit φ0 + Σ α_k h^{q_k}: (φ0, the fit at the finest mesh, σ, Σ residual²);
-/// `None` with fewer values than unknowns + 1 (no σ) or a singular system.
-fn fit_powers(p: &[(f64, f64)], powers: &[f64]) -> Option<(f64, f64, f64, f64)> {
+/// One least-squares fit φ0 + Σ α_k h^{q_k} ([`fit_powers`]).
+struct Fitted {
+    phi0: f64,
+    /// The fit at the finest mesh.
+    at_finest: f64,
+    /// σ = √(Σ residual² / (n − unknowns)), and Σ residual².
+    sigma: f64,
+    sse: f64,
+}
+
+/// The least-squares fit φ0 + Σ α_k h^{q_k} of `p`; `None` with fewer values than unknowns + 1
+/// (no σ) or a singular system.
+fn fit_powers(p: &[(f64, f64)], powers: &[f64]) -> Option<Fitted> {
     let (n, k) = (p.len(), powers.len() + 1);
     if n <= k {
         return None;
@@ -194,17 +206,17 @@ fn fit_powers(p: &[(f64, f64)], powers: &[f64]) -> Option<(f64, f64, f64, f64)> 
     let c = a.clone().svd(true, true).solve(&b, 1e-13).ok()?;
     let fitted = &a * &c;
     let sse: f64 = (0..n).map(|i| (b[i] - fitted[i]).powi(2)).sum();
-    c.iter().all(|x| x.is_finite()).then(|| (c[0], fitted[0], (sse / (n - k) as f64).sqrt(), sse))
+    c.iter().all(|x| x.is_finite()).then(|| Fitted { phi0: c[0], at_finest: fitted[0], sigma: (sse / (n - k) as f64).sqrt(), sse })
 }
 
 /// The free-order fit's p: the least Σ residual² over p in [`LS_ORDER_SEARCH`] (a scan of 400
 /// log-spaced orders, then golden-section search around the best).
 fn free_order(p: &[(f64, f64)]) -> f64 {
-    let sse = |q: f64| fit_powers(p, &[q]).map_or(f64::INFINITY, |f| f.3);
+    let sse = |q: f64| fit_powers(p, &[q]).map_or(f64::INFINITY, |f| f.sse);
     let (lo, hi) = (LS_ORDER_SEARCH.0.ln(), LS_ORDER_SEARCH.1.ln());
     const SCAN: usize = 400;
     let at = |i: usize| (lo + (hi - lo) * i as f64 / SCAN as f64).exp();
-    let best = (0..=SCAN).min_by(|&i, &j| sse(at(i)).total_cmp(&sse(at(j)))).unwrap_or(0);
+    let best = (0..=SCAN).map(|i| (i, sse(at(i)))).min_by(|a, b| a.1.total_cmp(&b.1)).map_or(0, |(i, _)| i);
     let (mut a, mut b) = (at(best.saturating_sub(1)), at((best + 1).min(SCAN)));
     let g = (5f64.sqrt() - 1.0) / 2.0;
     for _ in 0..60 {
@@ -236,8 +248,8 @@ pub fn least_squares(p: &[(f64, f64)]) -> Option<LeastSquares> {
     let chosen = candidates
         .iter()
         .filter_map(|&(fit, q)| fit_powers(p, q).map(|f| (fit, f)))
-        .min_by(|a, b| a.1 .2.total_cmp(&b.1 .2));
-    let Some((fit, (phi0, at1, sigma, _))) = chosen else {
+        .min_by(|a, b| a.1.sigma.total_cmp(&b.1.sigma));
+    let Some((fit, Fitted { phi0, at_finest: at1, sigma, .. })) = chosen else {
         // unreachable with four distinct sizes; kept as the unverified rule, not a panic
         return Some(LeastSquares { order, fit: Fit::FreeOrder, extrapolated: phi1, sigma: f64::NAN, data_range, safety: SAFETY_UNVERIFIED, uncertainty: SAFETY_UNVERIFIED * (hi - lo), finest_three_band: None });
     };
