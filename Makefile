@@ -105,7 +105,7 @@ run: venv build
 # report (<out>/report.md, report.json, charts/). STUDY=pipelines/x_study.json.
 study: venv build
 	@mk=$$($(BIN) study plan $(STUDY) --bin $(CURDIR)/$(BIN) | tee /dev/stderr | sed -n 's/^  makefile  //p') && \
-	  $(MAKE) --no-print-directory -j$(JOBS) -f $$mk all
+	  $(MAKE) --no-print-directory -j$(JOBS) -f $$mk all ALONE_THREADS=$(JOBS)
 	$(BIN) study report $(STUDY)
 
 # Only the report, from the runs already done.
@@ -177,9 +177,12 @@ dam-coarse:
 # the coarse, default, fine and h 2.5 m meshes (16 runs), then the extrapolated reference
 # pipelines/dam_reference.json that `make dam`'s report reads. Not run whole here: each h 2.5 m
 # NTS run takes about 1 h 10 min on 2 threads of a quiet machine and 12.8 GB (74 322 steps; NTS at
-# 3x measured: 828 s static, 3386 s dynamic; docs/dam.md, "The h 2.5 m runs"); each NTN one an
-# estimated 1.5-2 h (its static state needs 4-10x NTS's Newton iterations; its steps cost 0.7x
-# NTS's: docs/performance.md, "NTN's static state"). The NTS runs hold
+# 3x measured: 828 s static, 3386 s dynamic; docs/dam.md, "The h 2.5 m runs"); each NTN one about
+# 1 h 26 min and 12.6 GB (NTN 3x measured: 2246 s static, its Newton needing 5x NTS's
+# iterations; 2891 s dynamic: docs/performance.md, "NTN's static state"). The whole target is
+# about 6.5 h on 2 cores. The h 2.5 m mesh is `alone` in the study file: its four runs go first,
+# one at a time on $(JOBS) threads, the twelve others after them (two h 2.5 m runs at once would
+# need 25 GB; docs/studies.md, `alone`). The NTS runs hold
 # their re-entry penetrations (`reentry: "hold"`): pushed out, they stopped the h 2.5 m NTS 3x
 # run at t = 4.24 s (docs/contact.md, "Re-entry").
 # DAM_CONVERGENCE=pipelines/dam_convergence_affordable_study.json: coarse and default only

@@ -27,6 +27,13 @@ pub struct Variation {
     /// jobs end together. Axis values only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cost: Option<f64>,
+    /// The runs with this axis value need the machine to themselves [-] (default false): too
+    /// large in memory to run beside another (the dam's h 2.5 m mesh: 12.8 GB each, two of them
+    /// above a 24 GB machine). `runs.mk` runs them first, one at a time, each on
+    /// `$(ALONE_THREADS)` threads (`make study` passes its JOBS), and the other runs after them.
+    /// Axis values only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alone: Option<bool>,
     /// The study PGA [g]: the target PGA of the first base record; every record of the scene is
     /// scaled by the same factor, so the others keep their ratio to it (unlike a scene entry's
     /// own `pga`, the record PGA, which scales that record alone: `dynamics::loads::scale_for_pga`).
@@ -120,6 +127,9 @@ pub struct StudyFile {
 pub struct AxisValue {
     pub label: String,
     pub cost: f64,
+    /// [`Variation::alone`].
+    #[serde(default)]
+    pub alone: bool,
     pub variation: Variation,
 }
 
@@ -247,8 +257,8 @@ impl Study {
 /// and the checks of every variation.
 fn only_for_values(path: &Path, v: &Variation, field: &str) -> Result<(), StudyError> {
     let invalid = |message: String| StudyError::Invalid { path: path.to_path_buf(), message };
-    if v.label.is_some() || v.cost.is_some() {
-        return Err(invalid(format!("`{field}`: `label` and `cost` belong to axis values only")));
+    if v.label.is_some() || v.cost.is_some() || v.alone.is_some() {
+        return Err(invalid(format!("`{field}`: `label`, `cost` and `alone` belong to axis values only")));
     }
     check_variation(v, field).map_err(invalid)
 }
@@ -265,7 +275,8 @@ fn read_axis(path: &Path, a: &AxisFile, at: &str) -> Result<Axis, StudyError> {
                 let var: Variation = serde_json::from_value(v.clone()).map_err(|e| invalid(format!("{vat}: {e}")))?;
                 let label = var.label.clone().ok_or_else(|| invalid(format!("{vat}: an object value needs a `label` (its part of the run id; \"\" for none)")))?;
                 let cost = var.cost.unwrap_or(1.0);
-                AxisValue { label, cost, variation: Variation { label: None, cost: None, ..var } }
+                let alone = var.alone.unwrap_or(false);
+                AxisValue { label, cost, alone, variation: Variation { label: None, cost: None, alone: None, ..var } }
             }
             Value::Number(_) | Value::String(_) => {
                 let field = a.field.as_deref().ok_or_else(|| invalid(format!("{vat}: a bare value {v} needs the axis' `field` (pga, scale, set.<name>, joints.<field> or a scene path /…); or give an object with a `label`")))?;
@@ -275,7 +286,7 @@ fn read_axis(path: &Path, a: &AxisFile, at: &str) -> Result<Axis, StudyError> {
                     _ => unreachable!(),
                 };
                 let variation = field_variation(field, v).map_err(|m| invalid(format!("{at}: `field` = \"{field}\": {m}")))?;
-                AxisValue { label, cost: 1.0, variation }
+                AxisValue { label, cost: 1.0, alone: false, variation }
             }
             other => return Err(invalid(format!("{vat}: {other} is neither a number, a string nor an object"))),
         };

@@ -28,6 +28,10 @@ pub struct RunSpec {
     pub overrides: Vec<Variation>,
     /// Relative cost: the product of its values' costs.
     pub cost: f64,
+    /// One of its values is `alone` ([`super::file::Variation::alone`]): the run needs the
+    /// machine to itself.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub alone: bool,
     /// Target PGA [g] of the run's first record, when a variation sets one (the last wins).
     pub pga: Option<f64>,
 }
@@ -71,12 +75,13 @@ pub fn plan_runs(study: &Study) -> Result<Vec<RunSpec>, StudyError> {
                     let values: Vec<&super::file::AxisValue> = study.axes.iter().zip(&labels).map(|(a, (_, l))| a.value(l).expect("checked label")).collect();
                     let id = study.id_axes.iter().map(|&k| labels[k].1.as_str()).filter(|l| !l.is_empty()).collect::<Vec<_>>().join("-");
                     let cost = values.iter().map(|v| v.cost).product();
+                    let alone = values.iter().any(|v| v.alone);
                     let mut pga = study.all.pga;
                     for v in values.iter().map(|v| &v.variation).chain(std::iter::once(&sel.with)) {
                         pga = v.pga.or(pga);
                     }
                     let overrides = if sel.with.is_empty() { vec![] } else { vec![sel.with.clone()] };
-                    runs.push(RunSpec { id, labels, overrides, cost, pga });
+                    runs.push(RunSpec { id, labels, overrides, cost, alone, pga });
                 }
             }
             // next index of the product (last axis fastest)
@@ -102,7 +107,8 @@ pub fn plan_runs(study: &Study) -> Result<Vec<RunSpec>, StudyError> {
             return Err(invalid(format!("runs {:?} and {:?} get the same id \"{}\": give their values distinct labels (or add the axis to `id`)", o.labels, r.labels, r.id)));
         }
     }
-    runs.sort_by(|a, b| b.cost.total_cmp(&a.cost));
+    // the runs that need the machine alone first (runs.mk chains them), then by cost
+    runs.sort_by(|a, b| b.alone.cmp(&a.alone).then(b.cost.total_cmp(&a.cost)));
     Ok(runs)
 }
 
@@ -450,6 +456,7 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
     for line in run_recipe(&vars) {
         t.push_str(&format!("\t@{line}\n"));
     }
+    write_alone_rules_into(&runs, &mut t);
     for (s, spec) in plan.steps.iter().zip(steps) {
         let output = mk_path(&s.output)?;
         t.push_str(&format!("\n$(OUT)/.{n}.done: $(STUDY) {scene}\n", n = s.name, scene = mk_path(&absolute(&study.scene))?));
@@ -462,6 +469,28 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
     }
     write_if_changed(&mk, &t)?;
     Ok(PlanFiles { plan: plan_path, makefile: mk, scenes, changed, meshes })
+}
+
+/// The rules of `runs.mk` for the runs that need the machine alone ([`RunSpec::alone`]): each
+/// its own target on `$(ALONE_THREADS)` threads, after the previous one (order-only: a failed
+/// run does not stop the next), and every other run after the last of them; nothing when there
+/// are none.
+fn write_alone_rules_into(runs: &[RunSpec], t: &mut String) {
+    let alone: Vec<&str> = runs.iter().filter(|r| r.alone).map(|r| r.id.as_str()).collect();
+    let Some(last) = alone.last() else { return };
+    t.push_str("\n# Runs that need the machine alone (`alone` in the study): one at a time, first, each on\n");
+    t.push_str("# ALONE_THREADS threads; the other runs wait for the last of them.\nALONE_THREADS ?= 2\n");
+    for (k, id) in alone.iter().enumerate() {
+        let after = if k > 0 { format!(" | $(OUT)/runs/{}/.done", alone[k - 1]) } else { String::new() };
+        t.push_str(&format!("\n$(OUT)/runs/{id}/.done: $(OUT)/scenes/{id}.json{after}\n"));
+        let vars = RecipeVars { bin: "$(BIN)", out: "$(OUT)", id, cache: "$(CACHE)", threads: "$(ALONE_THREADS)", dollar: "$$" };
+        for line in run_recipe(&vars) {
+            t.push_str(&format!("\t@{line}\n"));
+        }
+    }
+    for r in runs.iter().filter(|r| !r.alone) {
+        t.push_str(&format!("$(OUT)/runs/{}/.done: | $(OUT)/runs/{last}/.done\n", r.id));
+    }
 }
 
 /// Where the commands of [`run_recipe`] find their parts: shell words (a path checked by the

@@ -297,3 +297,60 @@ fn study_patch_record_path_resolves_against_the_study_file() {
     let b = jointquake::scene::Scene::load(&dir.join("out/scenes/base.json")).unwrap();
     assert_eq!(std::fs::canonicalize(b.loads.base[0].record.as_ref().unwrap()).unwrap(), std::fs::canonicalize(&rec).unwrap());
 }
+
+/// `alone` axis values (src/study/file.rs, `Variation::alone`): runs.mk runs those runs first,
+/// one at a time, on ALONE_THREADS threads, and every other run after them. Checked by running
+/// the plan's own runs.mk with `make -j3` and a stand-in binary that logs when each run starts
+/// and ends (an alone run must never overlap another run, whatever make's job count).
+#[test]
+fn alone_runs_run_first_one_at_a_time_on_alone_threads_and_never_beside_another_run() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("study/alone");
+    let rec = manifest("pipelines/records/elcentro1940_NS_chopra.txt");
+    let p = write_study(
+        &dir,
+        &incline_scene(&rec, 1.0),
+        json!({"scene": "scene.json", "axes": [
+            {"name": "mesh", "values": [{"label": "small"}, {"label": "big", "cost": 40, "alone": true}]},
+            {"name": "pga", "field": "pga", "values": [0.25, 0.5, 0.75]}
+        ]}),
+    );
+    let s = Study::load(&p).unwrap();
+    let runs = plan_runs(&s).unwrap();
+    assert!(runs[..3].iter().all(|r| r.alone) && runs[3..].iter().all(|r| !r.alone), "alone runs first: {:?}", runs.iter().map(|r| (&r.id, r.alone)).collect::<Vec<_>>());
+    let files = write_plan(&s, &[], &dir.join("cache"), "jointquake").unwrap();
+    // the stand-in: `BIN run SCENE --out DIR --cache C --threads N --quiet`
+    let bin = dir.join("fake-bin");
+    let events = dir.join("events.txt");
+    std::fs::write(&bin, format!("#!/bin/sh\nid=$(basename \"$2\" .json)\necho \"start $id $8\" >> {e}\nsleep 0.3\necho \"end $id\" >> {e}\n", e = events.display())).unwrap();
+    std::fs::set_permissions(&bin, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let o = std::process::Command::new("make").args(["-s", "-j3", "-f"]).arg(&files.makefile).arg("runs").arg(format!("BIN={}", bin.display())).arg("ALONE_THREADS=3").output().unwrap();
+    assert!(o.status.success(), "make: {}", String::from_utf8_lossy(&o.stderr));
+    let log = std::fs::read_to_string(&events).unwrap();
+    let lines: Vec<Vec<&str>> = log.lines().map(|l| l.split(' ').collect()).collect();
+    assert_eq!(lines.len(), 12, "{log}");
+    let mut running: Vec<&str> = Vec::new();
+    let mut started = 0;
+    for l in &lines {
+        match l[0] {
+            "start" => {
+                let big = l[1].starts_with("big");
+                // the three big runs start first, each on ALONE_THREADS threads, the others on 1
+                assert_eq!(big, started < 3, "{log}");
+                assert_eq!(l[2], if big { "3" } else { "1" }, "{log}");
+                running.push(l[1]);
+                assert!(running.len() == 1 || running.iter().all(|r| !r.starts_with("big")), "an alone run beside another: {log}");
+                started += 1;
+            }
+            _ => running.retain(|r| *r != l[1]),
+        }
+    }
+    // make -j3 did run the small runs side by side (the check above could not fail otherwise)
+    let mut most = 0;
+    let mut n = 0i32;
+    for l in &lines {
+        n += if l[0] == "start" { 1 } else { -1 };
+        most = most.max(n);
+    }
+    assert!(most >= 2, "the small runs never overlapped: {log}");
+}
