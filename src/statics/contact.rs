@@ -25,7 +25,8 @@
 //! force is r_n = −k g (compressive positive). q is the force on the slave node (−N_I q on the
 //! masters). Forces in N, displacements in m.
 //! - **open** (r_n < −σ_t A: tension beyond the tensile strength, 0 for the dam): q = 0;
-//! - **stick** (k |w_t| ≤ L, L = `JointLaw::shear_limit`(r_n)): q = k w, tangent k I;
+//! - **stick** (k_t |w_t| ≤ L, L = `JointLaw::shear_limit`(r_n), k_t = [`STICK_TANGENTIAL`] k):
+//!   q = k g n + k_t w_t, tangent k n nᵀ + k_t (I − n nᵀ);
 //! - **slip**: q = k g n + L w_t/|w_t|, tangent k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) − L' k t̂ nᵀ
 //!   (L' = ∂L/∂r_n: μ, or tan(φ + i) below an asperity envelope's knee),
 //!   t̂ = w_t/|w_t|. The last term (the limit grows with the normal force) makes K_T
@@ -179,7 +180,7 @@ fn relative_motion(p: &Pair, uh: &[f64]) -> Vector3<f64> {
 }
 
 /// A pair's tangent ∂q/∂w split as `spd + coupling`: `spd` symmetric positive semi-definite
-/// (k I stick; k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) slip; 0 open), `coupling` the friction
+/// (k n nᵀ + k_t (I − n nᵀ) stick; k n nᵀ + (L/|w_t|)(I − n nᵀ − t̂ t̂ᵀ) slip; 0 open), `coupling` the friction
 /// limit's growth with the normal force (−L' k t̂ nᵀ while slipping, L' = ∂L/∂r_n, else 0), and
 /// the state.
 #[derive(Clone, Copy, Debug)]
@@ -200,8 +201,9 @@ fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, h
     let wt = w - p.n * g;
     let (limit, slope) = law.shear_limit_with_slope(r_n, &history, p.area);
     let nn = p.n * p.n.transpose();
-    if p.k * wt.norm() <= limit {
-        (PairState::Stick, w * p.k, PairTangent { state: PairState::Stick, spd: Matrix3::identity() * p.k, coupling: Matrix3::zeros() })
+    let kt = STICK_TANGENTIAL * p.k;
+    if kt * wt.norm() <= limit {
+        (PairState::Stick, p.n * (p.k * g) + wt * kt, PairTangent { state: PairState::Stick, spd: nn * p.k + (Matrix3::identity() - nn) * kt, coupling: Matrix3::zeros() })
     } else {
         let t = wt / wt.norm();
         let ks = limit / wt.norm();
@@ -212,6 +214,19 @@ fn pair_force(p: &Pair, w: &Vector3<f64>, law: &crate::contact::law::JointLaw, h
         (PairState::Slip, p.n * (p.k * g) + t * limit, PairTangent { state: PairState::Slip, spd, coupling })
     }
 }
+
+/// The stick spring's tangential stiffness as a fraction of the penalty k (dimensionless): 0.1.
+/// Why: like k, a regularisation of sticking, not a joint property (the earthquake's contact
+/// is the dynamic contact force, not springs); with k_t = k the stiff stick turns the holonomic
+/// slip direction t̂ = w_t/|w_t| at every Newton step and node-to-node joints, with 3× NTS's
+/// slipping pairs, crawled through 5× NTS's iterations (the dam's h 2.5 m NTN static state 37
+/// min). 0.1 k cuts NTN's iterations about 3× (coarse / default / fine 116 / 107 / 139 → 36 /
+/// 43 / 48) while the stick's tangential compliance stays 1 % of the mesh's next to it
+/// ([`PENALTY_FACTOR`]); measured: the default dam's static table moves by at most 0.4 %, the
+/// default 3× runs' peaks (opening, net slip, path, crest, face stresses) by at most 3e-5
+/// (docs/performance.md, "NTN's static state"). 0.01 k was faster still (24 / 27) with a
+/// 10 % compliance. Penalty codes commonly set k_s below k_n (3DEC: k_n/2 – k_n/10).
+pub const STICK_TANGENTIAL: f64 = 0.1;
 
 /// Smallest relative tolerance of a Newton direction's GMRES solve, ‖K_T d − R‖ ≤ η ‖R‖
 /// (dimensionless): 1e-9. Why: below it the solve is at the factorisation's round-off; the
