@@ -452,10 +452,7 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
         t.push_str(&format!(" $(OUT)/.{}.done", s.name));
     }
     t.push_str("\n\n$(OUT)/runs/%/.done: $(OUT)/scenes/%.json\n");
-    let vars = RecipeVars { bin: "$(BIN)", out: "$(OUT)", id: "$*", cache: "$(CACHE)", threads: "1", dollar: "$$" };
-    for line in run_recipe(&vars) {
-        t.push_str(&format!("\t@{line}\n"));
-    }
+    push_recipe_into(&RecipeVars { bin: "$(BIN)", out: "$(OUT)", id: "$*", cache: "$(CACHE)", threads: "1", dollar: "$$" }, &mut t);
     write_alone_rules_into(&runs, &mut t);
     for (s, spec) in plan.steps.iter().zip(steps) {
         let output = mk_path(&s.output)?;
@@ -471,6 +468,13 @@ pub fn write_plan(study: &Study, steps: &[StepSpec], mesh_cache: &Path, bin: &st
     Ok(PlanFiles { plan: plan_path, makefile: mk, scenes, changed, meshes })
 }
 
+/// [`run_recipe`]'s commands as the recipe lines of a `runs.mk` rule (silent, tab-indented).
+fn push_recipe_into(vars: &RecipeVars, t: &mut String) {
+    for line in run_recipe(vars) {
+        t.push_str(&format!("\t@{line}\n"));
+    }
+}
+
 /// The rules of `runs.mk` for the runs that need the machine alone ([`RunSpec::alone`]): each
 /// its own target on `$(ALONE_THREADS)` threads, after the previous one (order-only: a failed
 /// run does not stop the next), and every other run after the last of them; nothing when there
@@ -483,10 +487,7 @@ fn write_alone_rules_into(runs: &[RunSpec], t: &mut String) {
     for (k, id) in alone.iter().enumerate() {
         let after = if k > 0 { format!(" | $(OUT)/runs/{}/.done", alone[k - 1]) } else { String::new() };
         t.push_str(&format!("\n$(OUT)/runs/{id}/.done: $(OUT)/scenes/{id}.json{after}\n"));
-        let vars = RecipeVars { bin: "$(BIN)", out: "$(OUT)", id, cache: "$(CACHE)", threads: "$(ALONE_THREADS)", dollar: "$$" };
-        for line in run_recipe(&vars) {
-            t.push_str(&format!("\t@{line}\n"));
-        }
+        push_recipe_into(&RecipeVars { bin: "$(BIN)", out: "$(OUT)", id, cache: "$(CACHE)", threads: "$(ALONE_THREADS)", dollar: "$$" }, t);
     }
     for r in runs.iter().filter(|r| !r.alone) {
         t.push_str(&format!("$(OUT)/runs/{}/.done: | $(OUT)/runs/{last}/.done\n", r.id));
