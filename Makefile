@@ -179,12 +179,12 @@ dam-coarse:
 # NTS run takes about 1 h 10 min on 2 threads of a quiet machine and 12.8 GB (74 322 steps; NTS at
 # 3x measured: 828 s static, 3386 s dynamic; docs/dam.md, "The h 2.5 m runs"); each NTN one about
 # 1 h 26 min and 12.6 GB (NTN 3x measured: 2246 s static, its Newton needing 5x NTS's
-# iterations, 989 s since the stick's softer tangential spring; 2891 s dynamic: docs/performance.md, "NTN's static state"). The whole target is
-# about 6.5 h on 2 cores. The h 2.5 m mesh is `alone` in the study file: its four runs go first,
-# one at a time on $(JOBS) threads, the twelve others after them (two h 2.5 m runs at once would
-# need 25 GB; docs/studies.md, `alone`). The NTS runs hold
-# their re-entry penetrations (`reentry: "hold"`): pushed out, they stopped the h 2.5 m NTS 3x
-# run at t = 4.24 s (docs/contact.md, "Re-entry").
+# iterations, 989 s since the stick's softer tangential spring; 2891 s dynamic:
+# docs/performance.md, "NTN's static state"). The whole target is about 6.5 h on 2 cores. The
+# h 2.5 m mesh is `alone` in the study file: its four runs go first, one at a time on $(JOBS)
+# threads, the twelve others after them (two h 2.5 m runs at once would need 25 GB;
+# docs/studies.md, `alone`). The NTS runs hold their re-entry penetrations (`reentry: "hold"`):
+# pushed out, they stopped the h 2.5 m NTS 3x run at t = 4.24 s (docs/contact.md, "Re-entry").
 # DAM_CONVERGENCE=pipelines/dam_convergence_affordable_study.json: coarse and default only
 # (8 runs, about 18 CPU-minutes). DAM_CONVERGENCE=pipelines/dam_convergence_three_study.json:
 # coarse, default and fine (12 runs; the fine ones 15-18 min each on one core, about 67 min with
