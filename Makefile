@@ -178,9 +178,9 @@ dam-coarse:
 # pipelines/dam_reference.json that `make dam`'s report reads. Not run whole here: each h 2.5 m
 # NTS run takes about 1 h 10 min on 2 threads of a quiet machine and 12.8 GB (74 322 steps; NTS at
 # 3x measured: 828 s static, 3386 s dynamic; docs/dam.md, "The h 2.5 m runs"); each NTN one about
-# 1 h 26 min and 12.6 GB (NTN 3x measured: 2246 s static, its Newton needing 5x NTS's
-# iterations, 989 s since the stick's softer tangential spring; 2891 s dynamic:
-# docs/performance.md, "NTN's static state"). The whole target is about 6.5 h on 2 cores. The
+# 1 h 5 min and 12.6 GB (NTN 1x measured: 1 h 3 min 32 s, 972 s static, 2831 s dynamic; NTN's
+# Newton needs 2x NTS's iterations: docs/performance.md, "NTN's static state"). The whole
+# target is about 5 h 15 min on 2 cores (docs/dam.md, "Convergence"). The
 # h 2.5 m mesh is `alone` in the study file: its four runs go first, one at a time on $(JOBS)
 # threads, the twelve others after them (two h 2.5 m runs at once would need 25 GB;
 # docs/studies.md, `alone`). The NTS runs hold their re-entry penetrations (`reentry: "hold"`):
