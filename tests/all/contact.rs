@@ -192,24 +192,29 @@ fn contact_results_are_bit_identical_across_runs_and_threads() {
 
 /// The contact's parallel search (chunks of slave nodes) and parallel Gauss–Seidel (the pairs
 /// of one colour on several threads, one tick of the work list per colour) give bit-identically
-/// the displacements, forces, states and search events of one thread (src/contact/force.rs,
-/// "Threads"). Two boxes pressed together and sheared (64 slave nodes, 4 colours), 150 steps;
-/// with chunks of 5 slave nodes and colours of 4 pairs or more in parallel, so that both
-/// parallel paths run on two threads. Reference: the one-thread run; tolerance: none (bits).
+/// the displacements, forces, states, tangential displacements, work and search events of one
+/// thread (src/contact/force.rs, "Threads"). Three boxes stacked on two joints (64 and 49 slave
+/// nodes), pressed together and sheared, 150 steps; with chunks of 5 slave nodes and colours of 4
+/// pairs or more in parallel, so that both parallel paths run on two threads across two joints.
+/// Reference: the one-thread run; tolerance: none (bits).
 #[test]
 fn contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread() {
     use jointquake::mesh::structured::{add_box, BoxSpec};
     use jointquake::simulation::Simulation;
-    let mut mesh = Mesh { source: "<two boxes>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
+    let mut mesh = Mesh { source: "<three boxes>".into(), nodes: vec![], node_tags: vec![], cells: vec![], groups: vec![] };
     add_box(&mut mesh, &BoxSpec::new("lower", [1.0, 1.0, 0.2], [8, 8, 2]).at([0.0, 0.0, -0.2]));
     add_box(&mut mesh, &BoxSpec::new("upper", [1.0, 1.0, 0.2], [7, 7, 2]));
+    // a third box on a second joint: the search's tasks and the colours span two joints
+    add_box(&mut mesh, &BoxSpec::new("top", [1.0, 1.0, 0.2], [6, 6, 2]).at([0.0, 0.0, 0.2]));
     let mut sc = scene(json!({
         "geometry": {"msh": "unused.msh"},
         "materials": [{"group": "block:lower", "E": 1e9, "nu": 0.25, "rho": 2000.0},
-                      {"group": "block:upper", "E": 1e9, "nu": 0.25, "rho": 2000.0}],
+                      {"group": "block:upper", "E": 1e9, "nu": 0.25, "rho": 2000.0},
+                      {"group": "block:top", "E": 1e9, "nu": 0.25, "rho": 2000.0}],
         "boundary": [{"group": "lower:z0"}],
-        "joints": [{"name": "J", "master": "lower:z1", "slave": "upper:z0", "mu": 0.3}],
-        "loads": {"traction": [{"group": "upper:z1", "traction": [4e5, 1e5, -1e6]}]},
+        "joints": [{"name": "J", "master": "lower:z1", "slave": "upper:z0", "mu": 0.3},
+                   {"name": "K", "master": "upper:z1", "slave": "top:z0", "mu": 0.4}],
+        "loads": {"traction": [{"group": "top:z1", "traction": [4e5, 1e5, -1e6]}]},
         "time": {"duration": 1.0}
     }));
     sc.time.energy_tolerance = 1.0;
@@ -221,24 +226,33 @@ fn contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread() {
             let c = sim.contact.as_mut().unwrap();
             c.search_chunk = chunk;
             c.sweep_par_min = par_min;
-            let mut sweeps = 0;
+            let (mut sweeps, mut work) = (0, Vec::new());
             for _ in 0..150 {
-                sweeps += sim.step().unwrap().correction.iterations;
+                let info = sim.step().unwrap();
+                sweeps += info.correction.iterations;
+                work.push(info.correction.work.to_bits());
             }
-            let j = &sim.state.contact.joints[0];
             let mut bits: Vec<u64> = sim.state.u.iter().map(|v| v.to_bits()).collect();
-            bits.extend(j.pairs.iter().flat_map(|p| [p.r_n.to_bits(), p.r_t[0].to_bits(), p.r_t[1].to_bits(), p.gap.to_bits(), p.slip.to_bits(), p.state as u64, p.center as u64]));
-            let e = &j.events;
-            bits.extend([e.lost, e.recentred, e.fresh_searches, e.widened_layer2, e.projection_failures, sweeps as u64]);
-            let in_contact = j.pairs.iter().filter(|p| p.r_n > 0.0).count();
-            let slipping = j.pairs.iter().filter(|p| p.state == jointquake::contact::law::PairState::Slip).count();
+            bits.extend(work);
+            // the fewest pairs in contact on a joint (each must load the contact), and the
+            // slipping pairs of both
+            let (mut in_contact, mut slipping) = (usize::MAX, 0);
+            for j in &sim.state.contact.joints {
+                bits.extend(j.pairs.iter().flat_map(|p| [p.r_n.to_bits(), p.r_t[0].to_bits(), p.r_t[1].to_bits(), p.gap.to_bits(), p.slip.to_bits(), p.d_t[0].to_bits(), p.d_t[1].to_bits(), p.state as u64, p.center as u64]));
+                let e = &j.events;
+                bits.extend([e.lost, e.recentred, e.fresh_searches, e.widened_layer2, e.projection_failures, j.work.to_bits(), j.reentries as u64]);
+                in_contact = in_contact.min(j.pairs.iter().filter(|p| p.r_n > 0.0).count());
+                slipping += j.pairs.iter().filter(|p| p.state == jointquake::contact::law::PairState::Slip).count();
+            }
+            bits.push(sweeps as u64);
             (bits, in_contact, slipping, sweeps)
         })
     };
     let one = run(1, 256, 256);
     let (in_contact, slipping, sweeps) = (one.1, one.2, one.3);
-    println!("{in_contact} pairs in contact, {slipping} slipping, {sweeps} sweeps in 150 steps");
-    assert!(in_contact > 32 && sweeps > 150, "the case must load the contact ({in_contact} pairs, {sweeps} sweeps)");
+    println!("at least {in_contact} pairs in contact on each joint, {slipping} slipping, {sweeps} sweeps in 150 steps");
+    // more than half of the top joint's 49 slave nodes (64 on the lower one) in contact
+    assert!(in_contact > 24 && sweeps > 150, "the case must load both joints' contact ({in_contact} pairs, {sweeps} sweeps)");
     assert!(one.0 == run(1, 5, 4).0, "one thread: the chunk sizes changed the result");
     assert!(one.0 == run(2, 5, 4).0, "two threads, parallel search and sweeps: the result differs from one thread");
     assert!(one.0 == run(2, 256, 256).0, "two threads, default chunks: the result differs from one thread");
