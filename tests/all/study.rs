@@ -330,7 +330,7 @@ fn alone_runs_run_first_one_at_a_time_on_alone_threads_and_never_beside_another_
     let lines: Vec<Vec<&str>> = log.lines().map(|l| l.split(' ').collect()).collect();
     assert_eq!(lines.len(), 12, "{log}");
     let mut running: Vec<&str> = Vec::new();
-    let mut started = 0;
+    let (mut started, mut most) = (0, 0);
     for l in &lines {
         match l[0] {
             "start" => {
@@ -340,17 +340,12 @@ fn alone_runs_run_first_one_at_a_time_on_alone_threads_and_never_beside_another_
                 assert_eq!(l[2], if big { "3" } else { "1" }, "{log}");
                 running.push(l[1]);
                 assert!(running.len() == 1 || running.iter().all(|r| !r.starts_with("big")), "an alone run beside another: {log}");
+                most = most.max(running.len());
                 started += 1;
             }
             _ => running.retain(|r| *r != l[1]),
         }
     }
     // make -j3 did run the small runs side by side (the check above could not fail otherwise)
-    let mut most = 0;
-    let mut n = 0i32;
-    for l in &lines {
-        n += if l[0] == "start" { 1 } else { -1 };
-        most = most.max(n);
-    }
     assert!(most >= 2, "the small runs never overlapped: {log}");
 }
