@@ -318,7 +318,9 @@ pub struct DirectionStats {
 /// ([`products_per_factorisation`]), not on every change of a pair's state: K_T − P is then the friction couplings C_p (one rank-one
 /// term per slipping pair) and the changed blocks of the pairs that opened, slipped or moved
 /// since the factorisation, a correction of low rank that GMRES absorbs in a few products
-/// (on the fine dam a numeric factorisation costs as much as some hundred products). An
+/// (on the fine dam a numeric factorisation costs as much as some hundred products). P is also
+/// factorised first when the pairs that changed state since its factorisation are expected to
+/// take the rest of its worth ([`PRODUCTS_PER_CHANGED_PAIR`]). An
 /// attempt on a stale factor is capped at that many products and given up earlier when its
 /// residual's contraction cannot reach the forcing term by the cap ([`give_up_window`]); the
 /// direction is then solved on a fresh factorisation. From [`SINGLE_FROM`] unknowns the factor
@@ -343,6 +345,8 @@ struct TangentSolver {
     budget: f64,
     stats: DirectionStats,
     y: Vec<f64>,
+    /// Each pair's state at the last factorisation ([`PRODUCTS_PER_CHANGED_PAIR`]).
+    states_at_factor: Vec<PairState>,
 }
 
 /// Unknowns from which the preconditioner P is factorised in f32 (its solves rounding the
@@ -383,6 +387,23 @@ pub const GIVE_UP_WINDOW: usize = 5;
 fn give_up_window(cap: usize) -> usize {
     GIVE_UP_WINDOW.max(cap / 4)
 }
+
+/// GMRES products an attempt on a stale preconditioner is expected to take per pair whose
+/// state (open / stick / slip) changed since the factorisation (dimensionless): 2. The
+/// preconditioner is factorised again before a direction when the products since its last
+/// factorisation plus this expectation reach a factorisation's worth
+/// ([`products_per_factorisation`]), instead of trying the stale factor and giving the
+/// attempt up. Why: each such pair changes its block of P, a correction of rank ≤ 3, and GMRES
+/// needs about one product per independent direction of the correction (at most rank + 1);
+/// measured on the NTN dam's stage c, an attempt on a stale factor that converged took at most
+/// about 1 product per changed pair plus 10 on the h 2.5 m mesh and 8–24 products for 1–17
+/// changed pairs on the fine mesh, and the attempts given up were mostly those the
+/// expectation puts past the budget (the first iterations change 140–6 000 pairs). 2: below
+/// the rank's 3, above the h 2.5 m slope, as a wasted attempt (up to the give-up window, a
+/// quarter of the budget) costs more than an early factorisation. With it the h 2.5 m static
+/// states took 14 min 19 s (NTN) and 9 min 23 s (NTS) against 16 min 10 s and 13 min 48 s, the
+/// static table moving by 5e-7 (docs/performance.md §7b, "A stale factor is not tried…").
+pub const PRODUCTS_PER_CHANGED_PAIR: f64 = 2.0;
 
 /// Floating-point operations of one GMRES product with the preconditioner: the sparse product
 /// with P's pattern (2 per entry; the pair terms are of the same order), the two triangular
@@ -430,7 +451,15 @@ impl TangentSolver {
         }
         let pair_pos = entries.iter().map(|&(a, b, _)| pos(a, b)).collect();
         let n = k0.n_rows;
-        TangentSolver { p, k0_pos, pair_pos, chol: None, ordering, precision, products_since: 0, budget: 1.0, stats: DirectionStats::default(), y: vec![0.0; n] }
+        TangentSolver { p, k0_pos, pair_pos, chol: None, ordering, precision, products_since: 0, budget: 1.0, stats: DirectionStats::default(), y: vec![0.0; n], states_at_factor: Vec::new() }
+    }
+
+    /// The GMRES products an attempt on the current (stale) factor is expected to take at the
+    /// pairs' states `tangents`: [`PRODUCTS_PER_CHANGED_PAIR`] per pair whose state (open,
+    /// stick, slip) differs from the one it had at the factorisation.
+    fn stale_products_expected(&self, tangents: &[PairTangent]) -> f64 {
+        let changed = tangents.iter().zip(&self.states_at_factor).filter(|(t, s)| t.state != **s).count();
+        PRODUCTS_PER_CHANGED_PAIR * changed as f64
     }
 
     /// P's values for the tangents `tangents`, then its numeric factorisation.
@@ -464,6 +493,8 @@ impl TangentSolver {
         }
         done.map_err(|e| ModelError::Invalid(e.to_string()))?;
         self.products_since = 0;
+        self.states_at_factor.clear();
+        self.states_at_factor.extend(tangents.iter().map(|t| t.state));
         self.stats.factorisations += 1;
         if let Some(ch) = self.chol.as_ref() {
             self.stats.factor_entries = ch.factor_entries();
@@ -497,7 +528,7 @@ impl TangentSolver {
 
     /// r ← K_T⁻¹ r, to the relative residual `eta` (the forcing term).
     fn direction_in_place(&mut self, k0: &Csc, pairs: &[Pair], tangents: &[PairTangent], r: &mut [f64], eta: f64) -> Result<(), Error> {
-        let changed = self.chol.is_none() || self.products_since as f64 >= self.budget;
+        let changed = self.chol.is_none() || self.products_since as f64 + self.stale_products_expected(tangents) >= self.budget;
         if changed {
             self.factorise(k0, pairs, tangents)?;
         }
@@ -865,6 +896,51 @@ mod tests {
         assert_eq!(products_per_factorisation(20.0 * FACTOR_SPEEDUP * p, p), 20.0);
         assert_eq!(products_per_factorisation(0.0, p), 1.0);
         assert_eq!(products_per_factorisation(1.0, 0.0), 1.0);
+    }
+
+    /// `m` pairs each tying one node of a diagonal stiffness (k0 = I on 3 m unknowns) to the
+    /// ground along z, and their tangents: stick (k I) for the first m − `slipping`, slip
+    /// (k n nᵀ: no tangential stiffness) for the rest.
+    fn grounded_pairs(m: usize, slipping: usize) -> (Csc, Vec<Pair>, Vec<PairTangent>) {
+        let n = 3 * m;
+        let k0 = Csc { n_rows: n, n_cols: n, col_ptr: (0..=n).collect(), row: (0..n).collect(), val: vec![1.0; n] };
+        let normal = Vector3::z();
+        let pairs = (0..m)
+            .map(|i| Pair { joint: 0, index: i, w: [vec![(3 * i, 1.0)], vec![(3 * i + 1, 1.0)], vec![(3 * i + 2, 1.0)]], n: normal, k: 1.0, area: 1.0, closed: true, changes: 0 })
+            .collect();
+        let tangents = (0..m)
+            .map(|i| {
+                let (state, spd) = if i < m - slipping { (PairState::Stick, Matrix3::identity()) } else { (PairState::Slip, normal * normal.transpose()) };
+                PairTangent { state, spd, coupling: Matrix3::zeros() }
+            })
+            .collect();
+        (k0, pairs, tangents)
+    }
+
+    #[test]
+    fn a_stale_factor_is_not_tried_when_the_changed_pairs_would_take_the_budget() {
+        // The rule of PRODUCTS_PER_CHANGED_PAIR: with a factorisation worth 10 products and
+        // none made since it, 4 changed pairs (8 products expected) are tried on the stale
+        // factor, 5 (10 expected) are refactorised first. Exact counts.
+        let m = 12;
+        let (k0, pairs, stick) = grounded_pairs(m, 0);
+        for (slipping, refactorised) in [(0, false), (4, false), (5, true), (12, true)] {
+            let mut solver = TangentSolver::new(&k0, &pairs, FillOrdering::Amd, FactorPrecision::Double);
+            solver.factorise(&k0, &pairs, &stick).unwrap();
+            solver.budget = 10.0;
+            let (_, _, tangents) = grounded_pairs(m, slipping);
+            assert_eq!(solver.stale_products_expected(&tangents), PRODUCTS_PER_CHANGED_PAIR * slipping as f64);
+            let mut r = vec![1.0; 3 * m];
+            solver.direction_in_place(&k0, &pairs, &tangents, &mut r, 1e-10).unwrap();
+            assert_eq!(solver.stats.factorisations, if refactorised { 2 } else { 1 }, "{slipping} pairs slipping");
+            // the direction: (I + the pairs' stiffness)⁻¹ 1 = 1/2 on stuck dofs and on the
+            // slipping pairs' z, 1 on their x and y
+            for (i, v) in r.iter().enumerate() {
+                let slips = i / 3 >= m - slipping;
+                let want = if slips && i % 3 < 2 { 1.0 } else { 0.5 };
+                assert!((v - want).abs() < 1e-9, "unknown {i}: {v} against {want}");
+            }
+        }
     }
 
     #[test]
