@@ -44,8 +44,8 @@
 //! Then the step with each reservoir model against Westergaard's (`reservoir_models`, knob
 //! `JQ_DAM_RESERVOIR`, default "coarse"). Then the static state (`static_state`, knob
 //! `JQ_DAM_STATIC`; `JQ_DAM_STATIC_METHOD`, the contraction joints' method there: "nts", the
-//! scene's, or "ntn", whose Newton needs about twice NTS's iterations) and the static stages' fill with AMD and nested dissection (`static_fill`,
-//! knob `JQ_DAM_FILL`), both off by default.
+//! scene's, or "ntn", whose Newton needs about twice NTS's iterations) and the static stages'
+//! fill with AMD and nested dissection (`static_fill`, knob `JQ_DAM_FILL`), both off by default.
 //! Run: `cargo bench --bench dam`; results also in target/bench/dam.json.
 
 use jointquake::problem::foundation::CondensationMethod;
