@@ -206,10 +206,14 @@ fn main() {
                 for (nt, p) in pools.iter().skip(1) {
                     let (mut sw, c0, fj) = (0usize, cpu_s(), jointquake::par::fork_joins());
                     sim.contact.as_mut().expect("joints").timings = Some(Default::default());
+                    let par_calls = |sim: &Simulation| sim.contact.as_ref().expect("joints").sweep_threads.as_ref().map_or(0, |c| c.parallel_calls());
+                    let pc0 = par_calls(&sim);
                     let t: Vec<f64> = p.install(|| (0..repeats).map(|_| step(steps, &mut sim, &mut sw) / steps as f64).collect());
+                    // the share of the timed steps whose sweeps ran on all threads (chosen by timing)
+                    let par_share = (par_calls(&sim) - pc0) as f64 / timed;
                     let pt = sim.contact.as_ref().expect("joints").timings.clone().unwrap();
                     let forks = (jointquake::par::fork_joins() - fj) as f64 / timed;
-                    threads_rows.push((*nt, t, (cpu_s() - c0) / timed, sw as f64 / timed, pt, forks));
+                    threads_rows.push((*nt, t, (cpu_s() - c0) / timed, sw as f64 / timed, pt, forks, par_share));
                 }
                 let sweeps_per_step = sweeps as f64 / timed;
                 let unconverged: u64 = sim.state.contact.joints.iter().map(|j| j.unconverged_steps).sum();
@@ -266,12 +270,12 @@ fn main() {
                 let serial = shares[1] + shares[3];
                 println!("    CPU time {:.3} ms per step ({} thread{}, all threads), {forks_step:.1} fork-joins per step; the contact {:.0} % of the step: search {:.0} %, prepare {:.0} %, sweeps {:.0} %, record {:.0} % (serial: prepare and record)", 1e3 * cpu_step, pools[0].0, if pools[0].0 == 1 { "" } else { "s" }, 1e2 * contact / m, 1e2 * shares[0], 1e2 * shares[1], 1e2 * shares[2], 1e2 * shares[3]);
                 let mut threads_json = Vec::new();
-                for (nt, t, cpu, sw, pt, forks) in &threads_rows {
+                for (nt, t, cpu, sw, pt, forks, par_share) in &threads_rows {
                     let amdahl = 1.0 / (serial + (1.0 - serial) * pools[0].0 as f64 / *nt as f64);
                     let ms = |d: std::time::Duration| 1e3 * d.as_secs_f64() / pt.steps.max(1) as f64;
                     let parts_ms = [ms(pt.search), ms(pt.prepare), ms(pt.sweeps), ms(pt.record)];
-                    println!("    {nt} threads: step {:.3} / {:.3} ms, {:.2}× the {}-thread median (Amdahl bound with the contact's set-up and record serial: {amdahl:.2}×); CPU time {:.3} ms per step; {forks:.1} fork-joins per step; {sw:.1} sweeps per step; contact {:.3} ms (search {:.3}, prepare {:.3}, sweeps {:.3}, record {:.3})", 1e3 * best(t), 1e3 * median(t), m / median(t), pools[0].0, 1e3 * cpu, parts_ms.iter().sum::<f64>(), parts_ms[0], parts_ms[1], parts_ms[2], parts_ms[3]);
-                    threads_json.push(serde_json::json!({"threads": nt, "step_s": t, "best_step_s": best(t), "median_step_s": median(t), "speedup_median": m / median(t), "amdahl_bound": amdahl, "cpu_s_per_step": cpu, "fork_joins_per_step": forks, "gs_sweeps_per_step": sw, "contact_ms_search_prepare_sweeps_record": parts_ms}));
+                    println!("    {nt} threads: step {:.3} / {:.3} ms, {:.2}× the {}-thread median (Amdahl bound with the contact's set-up and record serial: {amdahl:.2}×); CPU time {:.3} ms per step; {forks:.1} fork-joins per step; {sw:.1} sweeps per step, on all threads in {:.0} % of the steps (chosen by timing); contact {:.3} ms (search {:.3}, prepare {:.3}, sweeps {:.3}, record {:.3})", 1e3 * best(t), 1e3 * median(t), m / median(t), pools[0].0, 1e3 * cpu, 1e2 * par_share, parts_ms.iter().sum::<f64>(), parts_ms[0], parts_ms[1], parts_ms[2], parts_ms[3]);
+                    threads_json.push(serde_json::json!({"threads": nt, "step_s": t, "best_step_s": best(t), "median_step_s": median(t), "speedup_median": m / median(t), "amdahl_bound": amdahl, "cpu_s_per_step": cpu, "fork_joins_per_step": forks, "gs_sweeps_per_step": sw, "sweeps_parallel_share": par_share, "contact_ms_search_prepare_sweeps_record": parts_ms}));
                 }
                 println!(
                     "    Gauss–Seidel {sweeps_per_step:.1} sweeps per step ({unconverged} unconverged steps since the start); per timed step: {:.2} fresh searches, {:.2} recentred, {:.2} lost, {:.2} projection failures",

@@ -12,7 +12,8 @@
 //! around the steps timed.
 //!
 //! Also [`with_awake_workers`]: a run's time loop with the pool's other workers kept awake
-//! between the step's regions.
+//! between the step's regions; and [`ThreadChoice`]: a loop's choice between one thread and all,
+//! made by timing both.
 //!
 //! A leaf (std and rayon only).
 
@@ -75,9 +76,148 @@ pub fn with_awake_workers<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     })
 }
 
+/// A loop's choice between one thread and all the pool's threads, made by timing both: every
+/// [`Self::PERIOD`] calls a trial of [`Self::TRIAL`] calls on one thread then as many on all
+/// threads, and the rest of the period on whichever cost less per unit of work over the trial.
+/// A new pool (another thread count) first runs [`Self::WARMUP`] calls on all threads untimed. Only for a
+/// loop whose result is the same either way (bit-identical on any number of threads): the choice
+/// depends on timings, so it must never change a value.
+///
+/// Why: the two vCPUs of a cloud VM may share a last-level cache or not, and the host moves them
+/// between the two placements during a run; a cache line going from one vCPU to the other then
+/// takes about 3.4× as long (a ping-pong's round trip of about 105 ns against 350 ns on the EPYC
+/// VM of docs/performance.md §7, "Two kinds of core pair"). A loop of many short regions whose
+/// data moves between the threads (the contact's Gauss–Seidel sweeps: about 50 colours a step of
+/// 10–30 µs each) gains on two threads in the first placement and loses in the second, so one
+/// choice made before the run is wrong in one of them.
+#[derive(Clone, Debug, Default)]
+pub struct ThreadChoice {
+    /// the pool's thread count at the last call (another count starts a new period)
+    threads: usize,
+    /// calls since the period count started
+    calls: u64,
+    /// seconds and work of the current trial, [one thread, all threads]
+    trial: [(f64, f64); 2],
+    /// the mode of the period's calls after its trial
+    parallel_after_trial: bool,
+    /// calls made on all threads, in all
+    parallel_calls: u64,
+}
+
+impl ThreadChoice {
+    /// Calls from one trial to the next: 512 (about 3 s of the fine dam's step, shorter than the
+    /// placements were seen to last; the trial's 16 calls in the slower mode cost at most 3 % of
+    /// the difference between the modes).
+    pub const PERIOD: u64 = 512;
+    /// Calls per mode in a trial: 16 (a dam step's sweeps vary by about ±30 % from step to
+    /// step; 16 steps average that to a few per cent). In blocks, not alternating: on the dam a
+    /// parallel call right after a one-thread call cost half what it costs among parallel calls
+    /// (measured, fine mesh; the data is still where one thread left it).
+    pub const TRIAL: u64 = 16;
+    /// Calls of a new pool before its first trial: 64 (the first one-thread calls on a new
+    /// pool cost 1.5× the later ones on the dam bench, which switches pools mid-run, and made
+    /// the first trial pick the wrong mode).
+    pub const WARMUP: u64 = 64;
+
+    /// Whether the next call runs on all threads: never on one thread; with more, as the
+    /// period's schedule says. A pool of another thread count than the last call's starts a new
+    /// period (with its trial).
+    pub fn parallel(&mut self) -> bool {
+        let threads = rayon::current_num_threads();
+        if threads != self.threads {
+            // the warm-up: the end of a period whose choice is all threads
+            *self = ThreadChoice { threads, calls: Self::PERIOD - Self::WARMUP, parallel_after_trial: true, parallel_calls: self.parallel_calls, ..ThreadChoice::default() };
+        }
+        threads > 1 && self.mode()
+    }
+
+    /// The schedule's mode for the next call (the trial: one thread, then all threads; then the
+    /// choice).
+    fn mode(&self) -> bool {
+        match self.calls % Self::PERIOD {
+            i if i < 2 * Self::TRIAL => i >= Self::TRIAL,
+            _ => self.parallel_after_trial,
+        }
+    }
+
+    /// Record the call just made (in the mode [`Self::parallel`] gave): its wall time [s] and its
+    /// work (any measure proportional to the loop's cost on one thread, e.g. pairs × sweeps).
+    pub fn record(&mut self, seconds: f64, work: f64) {
+        let parallel = self.threads > 1 && self.mode();
+        let i = self.calls % Self::PERIOD;
+        if i < 2 * Self::TRIAL {
+            let t = &mut self.trial[parallel as usize];
+            t.0 += seconds;
+            t.1 += work;
+            if i == 2 * Self::TRIAL - 1 {
+                let cost = |(s, w): (f64, f64)| if w > 0.0 { s / w } else { f64::INFINITY };
+                // a tie, or no work to compare: all threads, as without the choice
+                self.parallel_after_trial = cost(self.trial[1]) <= cost(self.trial[0]) || self.trial[0].1 == 0.0;
+                self.trial = [(0.0, 0.0); 2];
+            }
+        }
+        self.parallel_calls += parallel as u64;
+        self.calls += 1;
+    }
+
+    /// The calls made on all threads, in all.
+    pub fn parallel_calls(&self) -> u64 {
+        self.parallel_calls
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn thread_choice_takes_the_mode_that_cost_less_in_its_trial_and_tries_both_again_each_period() {
+        // Reference: the schedule of the doc (WARMUP calls on all threads on a new pool, then
+        // periods of TRIAL calls on one thread, TRIAL on all, and the cheaper per unit of work
+        // to the end of the period), with synthetic timings: one thread 1 s per unit of work,
+        // all threads `p` s per unit.
+        let run = |choice: &mut ThreadChoice, p: f64, calls: u64| {
+            let mut modes = Vec::new();
+            for _ in 0..calls {
+                let par = choice.parallel();
+                modes.push(par);
+                choice.record(if par { 2.0 * p } else { 2.0 }, 2.0);
+            }
+            modes
+        };
+        let (t, per, w) = (ThreadChoice::TRIAL as usize, ThreadChoice::PERIOD, ThreadChoice::WARMUP);
+        let trial = |m: &[bool]| m.iter().enumerate().all(|(i, &x)| x == (i >= t));
+        let two = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        two.install(|| {
+            let mut c = ThreadChoice::default();
+            let m = run(&mut c, 2.0, w);
+            assert!(m.iter().all(|&x| x), "the warm-up runs on all threads");
+            // all threads twice as slow: the trial, then one thread for the rest of the period
+            let m = run(&mut c, 2.0, per);
+            assert!(trial(&m[..2 * t]), "the trial: one thread, then all");
+            assert!(m[2 * t..].iter().all(|&x| !x), "one thread cost less: kept after the trial");
+            // the machine changes: all threads now cost half; the next period's trial finds it
+            let m = run(&mut c, 0.5, per);
+            assert!(trial(&m[..2 * t]), "the trial: one thread, then all");
+            assert!(m[2 * t..].iter().all(|&x| x), "all threads cost less: kept after the trial");
+            assert_eq!(c.parallel_calls(), w + per);
+            // another thread count mid-period: one thread never runs in parallel, and back on
+            // two the trial starts again
+            let m = one.install(|| run(&mut c, 0.5, 40));
+            assert!(m.iter().all(|&x| !x));
+            let m = run(&mut c, 0.5, w + 2 * ThreadChoice::TRIAL + 1);
+            let w = w as usize;
+            assert!(m[..w].iter().all(|&x| x) && trial(&m[w..w + 2 * t]) && m[w + 2 * t], "a new warm-up and trial, then all threads");
+            // a trial with no work at all keeps all threads (nothing to choose on)
+            let mut c = ThreadChoice::default();
+            for _ in 0..w + 2 * t {
+                c.parallel();
+                c.record(0.0, 0.0);
+            }
+            assert!(c.parallel());
+        });
+    }
     use rayon::prelude::*;
 
     #[test]

@@ -39,7 +39,13 @@
 //! parallel: two pairs of one colour share no moving node and a pair writes only its moving
 //! nodes, so a colour's pass gives the same positions in any order, and its pairs share one tick
 //! of the work list's clock (whether a pair is evaluated again depends only on the order of
-//! the colours' ticks). The result is bit-identical on any number of threads (test
+//! the colours' ticks). A colour is shared out in one part per thread, the same part of the
+//! active pairs in every colour, and each sweep's change is taken over the matching parts of
+//! the local nodes, so that a thread keeps its pairs and nodes in its cache through the sweeps.
+//! Whether the sweeps run on all threads or on one is chosen by timing both every 512 steps
+//! (`ContactSolver::sweep_threads`, `par::ThreadChoice`): where the vCPUs share no cache the
+//! parallel sweeps cost more than one thread's. The result is bit-identical on any number of
+//! threads and either choice (test
 //! `contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread`). The mortar pairs,
 //! the last colour (pairs past 63 colours) and the set-up and record stay on one thread.
 //!
@@ -182,9 +188,6 @@ struct MortarScratch {
 /// weights and the force on the slave [N].
 type PenaltyPair = (u32, [u32; 4], u8, [f64; 4], Vector3<f64>);
 
-/// Pairs per task of a colour's parallel Gauss–Seidel pass: 128 (about 128 × 50 ns of updates
-/// against a task's hand-over of about 1 µs).
-const SWEEP_CHUNK: usize = 128;
 
 /// A slice that the threads of one parallel pass read and write at disjoint places: the pairs
 /// of one colour ([`ContactSolver::order_by_color`]) and the nodes they move. Two pairs of one
@@ -468,6 +471,12 @@ pub struct ContactSolver<'m> {
     /// smaller colour's pass (about 50 ns a pair) costs no more than waking the other threads.
     /// The result does not depend on it (module doc, "Threads").
     pub sweep_par_min: usize,
+    /// Whether the sweeps run on all threads or on one, chosen by timing both every
+    /// [`crate::par::ThreadChoice::PERIOD`] steps (docs/performance.md §7, "Two kinds of core
+    /// pair": on two vCPUs that share no cache the parallel sweeps cost more than one thread's).
+    /// Default: chosen by timing. `None`: always on all threads (tests of the parallel path).
+    /// The result does not depend on it (module doc, "Threads").
+    pub sweep_threads: Option<crate::par::ThreadChoice>,
     /// The colour runs of `order`: start, end, and whether the run is one colour (false: the
     /// pairs in search order, or the last colour, which takes every pair past 63 colours and
     /// may hold pairs that share a node); swept one after the other.
@@ -528,7 +537,7 @@ impl<'m> ContactSolver<'m> {
         }
         let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
-        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_shared_passes: 50, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), shared_pairs: Vec::new(), shared_runs: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_shared_passes: 50, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, sweep_threads: Some(crate::par::ThreadChoice::default()), color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), shared_pairs: Vec::new(), shared_runs: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Slave faces whose mortar integrals were evaluated so far, all mortar joints together (the
@@ -802,13 +811,39 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
     m[0].max(m[1]).max(m[2].max(m[3]))
 }
 
+/// The local nodes of each part of the active pairs (part p: pairs `n p / parts ..
+/// n (p + 1) / parts`, as [`sweep_colors`] shares a colour out): `parts + 1` cuts into the
+/// local nodes, the nodes first listed by part p's pairs being `cuts[p]..cuts[p + 1]` (they are
+/// numbered in the order the pairs meet them, `list_pairs_into`; the mortar pairs' nodes come
+/// last, in the last part). Any cuts give the same result; these keep each thread on its nodes.
+fn local_cuts_of(active: &[Active], n_local: usize, parts: usize) -> Vec<usize> {
+    let n = active.len();
+    let mut cuts = vec![0; parts + 1];
+    let mut seen = 0usize;
+    let mut k = 0;
+    for p in 1..parts {
+        let end = n * p / parts;
+        while k < end {
+            let a = &active[k];
+            seen = a.local[..a.span()].iter().fold(seen, |m, &l| m.max(l as usize + 1));
+            k += 1;
+        }
+        cuts[p] = seen.min(n_local);
+    }
+    cuts[parts] = n_local;
+    cuts
+}
+
 /// One Gauss–Seidel pass over the node-to-segment pairs, run by run of `color_runs` (indices
 /// into `order`): a run that is one colour gives all its pairs one tick of the clock and, with
-/// `parallel` and at least `par_min` pairs, is shared out over the threads in chunks of
-/// [`SWEEP_CHUNK`] pairs (of `par_min` when that is smaller, as in the tests); another run ticks per pair, on one thread. The same result on any number
+/// `parallel` and at least `par_min` pairs, is shared out over the threads in one part per
+/// thread, part p being its pairs among the active pairs n p / T .. n (p + 1) / T (T threads), so
+/// that a thread keeps its pairs and their nodes in its cache from colour to colour (rayon's
+/// join gives the caller the first part); another run ticks per pair, on one thread. The same result on any number
 /// of threads (module doc, "Threads"). Returns what [`sweep_pass`] returns, summed.
 #[allow(clippy::too_many_arguments)]
 fn sweep_colors<const LISTED: bool>(active: &mut [Active], order: &[u32], color_runs: &[(u32, u32, bool)], local: &mut [LocalNode], evaluated_at: &mut [u32], clock: &mut u32, laws: &[JointLaw], mark_tol2: f64, mob_matrix: &[[Matrix3<f64>; 5]], parallel: bool, par_min: usize) -> usize {
+    let active_len = active.len();
     let (pa, pl, pe) = (Shared::of(active), Shared::of(local), Shared::of(evaluated_at));
     let mut moving = 0;
     for &(start, end, colour) in color_runs {
@@ -832,7 +867,11 @@ fn sweep_colors<const LISTED: bool>(active: &mut [Active], order: &[u32], color_
         };
         moving += if parallel && run.len() >= par_min {
             crate::par::region();
-            run.par_chunks(SWEEP_CHUNK.min(par_min.max(1))).map(pass).sum::<usize>()
+            // part p: the colour's pairs among active pairs n p / T .. n (p + 1) / T, the same
+            // part in every colour, so that a thread keeps its pairs and nodes
+            let parts = rayon::current_num_threads();
+            let cut = |p: usize| run.partition_point(|&k| (k as usize) < active_len * p / parts);
+            (0..parts).into_par_iter().with_max_len(1).map(|p| pass(&run[cut(p)..cut(p + 1)])).sum::<usize>()
         } else {
             pass(run)
         };
@@ -1663,14 +1702,16 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, color_runs, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, .. } = self;
-        let parallel = rayon::current_num_threads() > 1;
+        let ContactSolver { active, order, color_runs, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, sweep_threads, .. } = self;
+        let parallel = rayon::current_num_threads() > 1 && sweep_threads.as_mut().is_none_or(|c| c.parallel());
         let mut sweeps = 0;
         let pairs = active.len() + mortar.active.len();
         let mut converged = pairs == 0;
         for (x0, l) in sweep_start.iter_mut().zip(local.iter()) {
             *x0 = l.x;
         }
+        // each sweep's change by parts of the local nodes, as the colours share out the pairs
+        let local_cuts: Vec<usize> = if parallel { local_cuts_of(active, local.len(), rayon::current_num_threads()) } else { Vec::new() };
         // Full sweeps first, the work list once it pays: while at least half the pairs moved a
         // node by more than the marking tolerance in the last sweep, a sweep evaluates every pair
         // without reading or stamping clocks (the list would skip few: 8 % on the contact
@@ -1720,7 +1761,21 @@ impl ContactSolver<'_> {
                     }
                 };
             }
-            let max_du = sweep_change_into(local, sweep_start).sqrt();
+            let max_du = if local_cuts.len() > 2 {
+                crate::par::region();
+                let mut pieces: Vec<(&[LocalNode], &mut [Vector3<f64>])> = Vec::with_capacity(local_cuts.len() - 1);
+                let mut rest: &mut [Vector3<f64>] = sweep_start;
+                for w in local_cuts.windows(2) {
+                    let (head, tail) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+                    pieces.push((&local[w[0]..w[1]], head));
+                    rest = tail;
+                }
+                // the largest of the parts' largest changes: the same as one pass's
+                pieces.into_par_iter().with_max_len(1).map(|(l, s)| sweep_change_into(l, s)).reduce(|| 0.0, f64::max)
+            } else {
+                sweep_change_into(local, sweep_start)
+            }
+            .sqrt();
             residual = max_du;
             converged = max_du <= *gs_tolerance
                 || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e)) && !m.active.iter().zip(m.evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
@@ -1851,7 +1906,12 @@ impl Constraint<ContactState> for ContactSolver<'_> {
         let t_prepare = now_if(timed);
         self.prepare_sweeps_into(u_next);
         let t_sweeps = now_if(timed);
+        let t0 = std::time::Instant::now();
         let (sweeps, converged, residual, worst) = self.sweep_into(u_next);
+        if let Some(c) = self.sweep_threads.as_mut() {
+            // the work: pairs × sweeps (the same measure in both modes)
+            c.record(t0.elapsed().as_secs_f64(), (sweeps * (self.active.len() + self.mortar.active.len())) as f64);
+        }
         let t_record = now_if(timed);
         let work = penalty_work + self.record_into(history, sweeps, converged, residual, u_prev, worst.map(|k| (k, step.t_next)));
         if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {

@@ -219,13 +219,18 @@ fn contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread() {
     }));
     sc.time.energy_tolerance = 1.0;
     let pb = problem(mesh, &sc, 0.9);
-    let run = |threads: usize, chunk: usize, par_min: usize| {
+    // `timed`: the sweeps' threads chosen by timing (the default, which switches between one
+    // thread and two within these 150 steps); otherwise always all threads
+    let run = |threads: usize, chunk: usize, par_min: usize, timed: bool| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
             let mut sim = Simulation::new(&pb).unwrap();
             let c = sim.contact.as_mut().unwrap();
             c.search_chunk = chunk;
             c.sweep_par_min = par_min;
+            if !timed {
+                c.sweep_threads = None;
+            }
             let (mut sweeps, mut work) = (0, Vec::new());
             for _ in 0..150 {
                 let info = sim.step().unwrap();
@@ -248,14 +253,15 @@ fn contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread() {
             (bits, in_contact, slipping, sweeps)
         })
     };
-    let one = run(1, 256, 256);
+    let one = run(1, 256, 256, true);
     let (in_contact, slipping, sweeps) = (one.1, one.2, one.3);
     println!("at least {in_contact} pairs in contact on each joint, {slipping} slipping, {sweeps} sweeps in 150 steps");
     // more than half of the top joint's 49 slave nodes (64 on the lower one) in contact
     assert!(in_contact > 24 && sweeps > 150, "the case must load both joints' contact ({in_contact} pairs, {sweeps} sweeps)");
-    assert!(one.0 == run(1, 5, 4).0, "one thread: the chunk sizes changed the result");
-    assert!(one.0 == run(2, 5, 4).0, "two threads, parallel search and sweeps: the result differs from one thread");
-    assert!(one.0 == run(2, 256, 256).0, "two threads, default chunks: the result differs from one thread");
+    assert!(one.0 == run(1, 5, 4, false).0, "one thread: the chunk sizes changed the result");
+    assert!(one.0 == run(2, 5, 4, false).0, "two threads, parallel search and sweeps: the result differs from one thread");
+    assert!(one.0 == run(2, 5, 4, true).0, "two threads, the sweeps' threads chosen by timing: the result differs from one thread");
+    assert!(one.0 == run(2, 256, 256, true).0, "two threads, default chunks: the result differs from one thread");
 }
 
 /// One run of the El Centro incline case of the tests here through `pipeline::run`

@@ -313,6 +313,8 @@ fn coarse_wedge_caps(angles: [Option<f64>; 2], duration: f64, threads: usize, sh
         let c = sim.contact.as_mut().unwrap();
         c.gs_shared_passes = shared_passes;
         c.sweep_par_min = 4;
+        // the colours on all threads in every step (not chosen by timing)
+        c.sweep_threads = None;
         sim.equilibrate().unwrap();
         for _ in 0..sim.n_steps() {
             sim.step().unwrap();
