@@ -12,8 +12,8 @@
 //! around the steps timed.
 //!
 //! Also [`with_awake_workers`]: a run's time loop with the pool's other workers kept awake
-//! between the step's regions; and [`ThreadChoice`]: a loop's choice between one thread and all,
-//! made by timing both.
+//! between the step's regions; [`ThreadChoice`]: a loop's choice between one thread and all,
+//! made by timing both; [`concat_into`]: vectors concatenated on all threads.
 //!
 //! A leaf (std and rayon only).
 
@@ -75,6 +75,47 @@ pub fn with_awake_workers<R: Send>(f: impl FnOnce() -> R + Send) -> R {
         f()
     })
 }
+
+/// The vectors `field(part)` of `parts` concatenated in order into `out` (cleared first), each
+/// part's copied by whichever thread takes that part in a parallel loop over `parts` (rayon
+/// splits the list alike each time: on two threads the caller takes the first half and the
+/// other thread the second, so that a part is mostly copied by the thread that filled it in an
+/// earlier loop over the same list, from its own cache). The parts' vectors are left empty, with
+/// their capacity. On one thread, or below `CONCAT_PAR_MIN` entries, one thread appends them.
+pub fn concat_into<S: Send, T: Copy + Send + Sync>(out: &mut Vec<T>, parts: &mut [S], field: impl Fn(&mut S) -> &mut Vec<T> + Sync) {
+    use rayon::prelude::*;
+    out.clear();
+    let total: usize = parts.iter_mut().map(|p| field(p).len()).sum();
+    if rayon::current_num_threads() == 1 || total < CONCAT_PAR_MIN {
+        for p in parts.iter_mut() {
+            out.append(field(p));
+        }
+        return;
+    }
+    out.reserve(total);
+    let mut pieces = Vec::with_capacity(parts.len());
+    let mut rest = &mut out.spare_capacity_mut()[..total];
+    for p in parts.iter_mut() {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(field(p).len());
+        pieces.push(head);
+        rest = tail;
+    }
+    region();
+    pieces.into_par_iter().zip(parts.par_iter_mut()).for_each(|(dst, p)| {
+        let src = field(p);
+        for (d, s) in dst.iter_mut().zip(src.iter()) {
+            d.write(*s);
+        }
+        src.clear();
+    });
+    // SAFETY: the pieces cover out's first `total` entries (their lengths sum to it), and each
+    // was written from its part's vector of the same length
+    unsafe { out.set_len(total) };
+}
+
+/// Entries below which [`concat_into`] appends on one thread: 4096 (a few hundred kB of the
+/// contact's pairs; below, a fork-join costs about what the copy does).
+pub const CONCAT_PAR_MIN: usize = 4096;
 
 /// A loop's choice between one thread and all the pool's threads, made by timing both: every
 /// [`Self::PERIOD`] calls a trial of [`Self::TRIAL`] calls on one thread then as many on all
@@ -169,6 +210,23 @@ impl ThreadChoice {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn concat_into_gives_the_parts_in_order_on_any_thread_count_and_empties_them() {
+        // Reference: the serial concatenation; parts of unequal length (some empty), enough
+        // entries for the parallel copy, on 1 and 2 threads.
+        let make = || (0..37u64).map(|p| (0..(p * 613 % 401)).map(|i| p * 1000 + i).collect::<Vec<u64>>()).collect::<Vec<_>>();
+        let expected: Vec<u64> = make().concat();
+        assert!(expected.len() > CONCAT_PAR_MIN);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut parts = make();
+            let mut out = vec![7u64; 3];
+            pool.install(|| concat_into(&mut out, &mut parts, |p| p));
+            assert_eq!(out, expected, "{threads} threads");
+            assert!(parts.iter().all(|p| p.is_empty()));
+        }
+    }
 
     #[test]
     fn thread_choice_takes_the_mode_that_cost_less_in_its_trial_and_tries_both_again_each_period() {

@@ -511,6 +511,12 @@ pub struct ContactSolver<'m> {
     local: Vec<LocalNode>,
     local_global: Vec<u32>,
     sweep_start: Vec<Vector3<f64>>,
+    /// With the sweeps on all threads: the local nodes of each thread's part of the active pairs
+    /// (`local_cuts_of_into`), for the sweeps' change and the record's write-back.
+    local_cuts: Vec<usize>,
+    /// The record's per-pair results when it runs on all threads: joint, work [J], re-entry,
+    /// summed into the joints in pair order after.
+    pair_work: Vec<(u32, f64, bool)>,
     /// The shared-node pass ([`shared_node_pass`]): the active pairs (indices into `active`) of
     /// the slave nodes with pairs on two or more joints with an asperity envelope, grouped by
     /// node (`shared_runs`: start and end in `shared_pairs`), in the order of the nodes' local
@@ -537,7 +543,7 @@ impl<'m> ContactSolver<'m> {
         }
         let unformed = super::joint::unformed_pairs(joints);
         let partial: Vec<u32> = (0..model.n_nodes()).filter(|&n| model.fixed[n] != 0 && inv_mass[n] > 0.0).map(|n| n as u32).collect();
-        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_shared_passes: 50, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, sweep_threads: Some(crate::par::ThreadChoice::default()), color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), shared_pairs: Vec::new(), shared_runs: Vec::new(), inv_mass, cand: Vec::new() }
+        ContactSolver { mortar: MortarScratch::default(), block_nodes, unformed, partial, mob_matrix: Vec::new(), joints, gs_tolerance: 1e-12 * size.max(1e-300), gs_max_sweeps: 200, gs_shared_passes: 50, gs_warm_start: true, keep_bonds: false, timings: None, gs_colored: true, color_mask: Vec::new(), colors: Vec::new(), order: Vec::new(), active: Vec::new(), penalty: Vec::new(), search_chunks: Vec::new(), search_chunk: 256, sweep_par_min: 256, sweep_threads: Some(crate::par::ThreadChoice::default()), color_runs: Vec::new(), node: vec![NodeScratch::default(); model.n_nodes()], evaluated_at: Vec::new(), step_clock: 0, local: Vec::new(), local_global: Vec::new(), sweep_start: Vec::new(), local_cuts: Vec::new(), pair_work: Vec::new(), shared_pairs: Vec::new(), shared_runs: Vec::new(), inv_mass, cand: Vec::new() }
     }
 
     /// Slave faces whose mortar integrals were evaluated so far, all mortar joints together (the
@@ -816,9 +822,10 @@ fn sweep_change_into(local: &[LocalNode], start: &mut [Vector3<f64>]) -> f64 {
 /// local nodes, the nodes first listed by part p's pairs being `cuts[p]..cuts[p + 1]` (they are
 /// numbered in the order the pairs meet them, `list_pairs_into`; the mortar pairs' nodes come
 /// last, in the last part). Any cuts give the same result; these keep each thread on its nodes.
-fn local_cuts_of(active: &[Active], n_local: usize, parts: usize) -> Vec<usize> {
+fn local_cuts_of_into(cuts: &mut Vec<usize>, active: &[Active], n_local: usize, parts: usize) {
     let n = active.len();
-    let mut cuts = vec![0; parts + 1];
+    cuts.clear();
+    cuts.resize(parts + 1, 0);
     let mut seen = 0usize;
     let mut k = 0;
     for p in 1..parts {
@@ -831,7 +838,6 @@ fn local_cuts_of(active: &[Active], n_local: usize, parts: usize) -> Vec<usize> 
         cuts[p] = seen.min(n_local);
     }
     cuts[parts] = n_local;
-    cuts
 }
 
 /// One Gauss–Seidel pass over the node-to-segment pairs, run by run of `color_runs` (indices
@@ -1075,9 +1081,11 @@ impl ContactSolver<'_> {
         } else {
             tasks.iter_mut().zip(chunks.iter_mut()).for_each(|(t, out)| search(t, out));
         }
+        // the pairs and their matrices (a few MB on the fine dam) copied on all threads, each
+        // task's mostly by the thread that searched it
+        crate::par::concat_into(&mut self.active, &mut chunks, |c| &mut c.active);
+        crate::par::concat_into(&mut self.mob_matrix, &mut chunks, |c| &mut c.mob_matrix);
         for (out, &ji) in chunks.iter_mut().zip(&task_joints) {
-            self.active.append(&mut out.active);
-            self.mob_matrix.append(&mut out.mob_matrix);
             self.penalty.append(&mut out.penalty);
             history.joints[ji].events.add(&out.events);
             out.events = SearchEvents::default();
@@ -1691,10 +1699,12 @@ impl ContactSolver<'_> {
         }
     }
 
-    /// The Gauss–Seidel sweeps over the active pairs; returns the sweeps made and whether they
-    /// reached `gs_tolerance`.
+    /// The Gauss–Seidel sweeps over the active pairs (on the local nodes; `record_into` writes
+    /// them back into the prediction); returns the sweeps made, whether they reached
+    /// `gs_tolerance`, the residual, the node that moved most in a last allowed sweep, and
+    /// whether they ran on all threads (the local nodes' parts then in `local_cuts`).
     #[inline(never)]
-    fn sweep_into(&mut self, u_next: &mut [f64]) -> (usize, bool, f64, Option<u32>) {
+    fn sweep_into(&mut self) -> (usize, bool, f64, Option<u32>, bool) {
         let mut clock = 1u32;
         // A node moved by less than 1 % of the tolerance does not call its pairs back: their
         // forces would change by a fraction of that (the fixed point is the same to within the
@@ -1702,7 +1712,7 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, color_runs, local, local_global, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, sweep_threads, .. } = self;
+        let ContactSolver { active, order, color_runs, local, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, sweep_threads, local_cuts: cuts, .. } = self;
         let parallel = rayon::current_num_threads() > 1 && sweep_threads.as_mut().is_none_or(|c| c.parallel());
         let mut sweeps = 0;
         let pairs = active.len() + mortar.active.len();
@@ -1711,7 +1721,11 @@ impl ContactSolver<'_> {
             *x0 = l.x;
         }
         // each sweep's change by parts of the local nodes, as the colours share out the pairs
-        let local_cuts: Vec<usize> = if parallel { local_cuts_of(active, local.len(), rayon::current_num_threads()) } else { Vec::new() };
+        let mut local_cuts: Vec<usize> = std::mem::take(cuts);
+        local_cuts.clear();
+        if parallel {
+            local_cuts_of_into(&mut local_cuts, active, local.len(), rayon::current_num_threads());
+        }
         // Full sweeps first, the work list once it pays: while at least half the pairs moved a
         // node by more than the marking tolerance in the last sweep, a sweep evaluates every pair
         // without reading or stamping clocks (the list would skip few: 8 % on the contact
@@ -1781,20 +1795,18 @@ impl ContactSolver<'_> {
                 || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e)) && !m.active.iter().zip(m.evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
         }
         let worst = (!converged && !before_last.is_empty()).then(|| local.iter().zip(&before_last).enumerate().map(|(k, (l, b))| (k as u32, (l.x - b).norm_squared())).fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a }).0);
-        // the corrected displacements back into the prediction
-        for (l, &nd) in local.iter().zip(local_global.iter()) {
-            let v = &mut u_next[3 * nd as usize..3 * nd as usize + 3];
-            v[0] = l.x[0];
-            v[1] = l.x[1];
-            v[2] = l.x[2];
-        }
-        (sweeps, converged, residual, worst)
+        *cuts = local_cuts;
+        (sweeps, converged, residual, worst, parallel)
     }
 
-    /// Write the active pairs' results into the history and return the contact work of the
-    /// step [J].
+    /// The sweeps' local nodes back into the prediction `u_next`, the active pairs' results into
+    /// the history; returns the contact work of the step [J]. With `parallel` (the sweeps ran on
+    /// all threads), each thread writes back its part's nodes and records its part's pairs (those
+    /// it swept, still in its cache), the joints' sums following in pair order on one thread:
+    /// the same values as one thread's.
     #[inline(never)]
-    fn record_into(&self, history: &mut ContactState, sweeps: usize, converged: bool, residual: f64, u_prev: &[f64], worst: Option<(u32, f64)>) -> f64 {
+    #[allow(clippy::too_many_arguments)]
+    fn record_into(&mut self, history: &mut ContactState, u_next: &mut [f64], sweeps: usize, converged: bool, residual: f64, u_prev: &[f64], worst: Option<(u32, f64)>, parallel: bool) -> f64 {
         let mut work = 0.0;
         let cap = worst.filter(|_| !converged && history.joints.iter().any(|r| residual > r.max_gs_residual)).map(|(k, t)| self.cap_step(k, t, residual));
         for rec in history.joints.iter_mut() {
@@ -1809,11 +1821,62 @@ impl ContactSolver<'_> {
                 rec.max_gs_residual = rec.max_gs_residual.max(residual);
             }
         }
-        for a in &self.active {
-            work += record_pair_into(a, history, &self.local, u_prev);
+        if parallel && self.local_cuts.len() > 2 {
+            work += self.record_parts_into(history, u_next, u_prev);
+        } else {
+            for (l, &nd) in self.local.iter().zip(self.local_global.iter()) {
+                u_next[3 * nd as usize..3 * nd as usize + 3].copy_from_slice(l.x.as_slice());
+            }
+            for a in &self.active {
+                work += record_pair_into(a, history, &self.local, u_prev);
+            }
         }
         for a in &self.mortar.active {
             work += record_pair_into(a, history, &self.local, u_prev);
+        }
+        work
+    }
+
+    /// [`Self::record_into`] on all threads: part p writes back local nodes `local_cuts[p]..
+    /// local_cuts[p + 1]` and records active pairs `n p / T .. n (p + 1) / T` (the sweeps'
+    /// parts); then the joints' sums in pair order. Returns the work of the node-to-segment
+    /// pairs [J].
+    fn record_parts_into(&mut self, history: &mut ContactState, u_next: &mut [f64], u_prev: &[f64]) -> f64 {
+        let parts = self.local_cuts.len() - 1;
+        let n = self.active.len();
+        self.pair_work.clear();
+        self.pair_work.resize(n, (0, 0.0, false));
+        let records: Vec<Shared<PairRecord>> = history.joints.iter_mut().map(|r| Shared::of(&mut r.pairs)).collect();
+        let u = Shared::of(u_next);
+        let (active, local, local_global, cuts) = (&self.active, &self.local, &self.local_global, &self.local_cuts);
+        let mut pieces: Vec<(usize, &mut [(u32, f64, bool)])> = Vec::with_capacity(parts);
+        let mut rest: &mut [(u32, f64, bool)] = &mut self.pair_work;
+        for p in 0..parts {
+            let (a, b) = (n * p / parts, n * (p + 1) / parts);
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(b - a);
+            pieces.push((p, head));
+            rest = tail;
+        }
+        crate::par::region();
+        pieces.into_par_iter().with_max_len(1).for_each(|(p, out)| {
+            for (l, &nd) in local[cuts[p]..cuts[p + 1]].iter().zip(&local_global[cuts[p]..cuts[p + 1]]) {
+                for d in 0..3 {
+                    // SAFETY: each local node is one global node, written by its part alone
+                    unsafe { *u.at(3 * nd as usize + d) = l.x[d] };
+                }
+            }
+            for (a, w) in active[n * p / parts..n * (p + 1) / parts].iter().zip(out.iter_mut()) {
+                // SAFETY: each active pair is one record (its joint's slave node), written by its
+                // part alone
+                let rec = unsafe { records[a.joint as usize].at(a.pair as usize) };
+                let (work, reentry) = record_pair_fields_into(a, rec, local, u_prev);
+                *w = (a.joint, work, reentry);
+            }
+        });
+        let mut work = 0.0;
+        for &(j, w, reentry) in &self.pair_work {
+            add_pair_work(&mut history.joints[j as usize], w, reentry);
+            work += w;
         }
         work
     }
@@ -1859,10 +1922,26 @@ fn list_pairs_into<const N: usize>(active: &mut [Active<N>], node: &mut [NodeScr
 /// Write active pair `a`'s result into the history; returns the work of its force over the
 /// step [J].
 fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, local: &[LocalNode], u_prev: &[f64]) -> f64 {
-    let i = a.pair as usize;
-    let [n, t1, t2] = a.frame;
     let rec = &mut history.joints[a.joint as usize];
-    let p = &mut rec.pairs[i];
+    let (work, reentry) = record_pair_fields_into(a, &mut rec.pairs[a.pair as usize], local, u_prev);
+    add_pair_work(rec, work, reentry);
+    work
+}
+
+/// The joint's sums of a recorded pair's work (`record_pair_fields_into`), in the order of the
+/// pairs (the sums are floating-point: the order is the result).
+fn add_pair_work(rec: &mut JointRecord, work: f64, reentry: bool) {
+    rec.work += work;
+    if reentry {
+        rec.reentries += 1;
+        rec.reentry_work += work.max(0.0);
+    }
+}
+
+/// Write active pair `a`'s result into its record `p`; returns the work of its force over the
+/// step [J] and whether it re-entered (for its joint's sums, `add_pair_work`).
+fn record_pair_fields_into<const N: usize>(a: &Active<N>, p: &mut PairRecord, local: &[LocalNode], u_prev: &[f64]) -> (f64, bool) {
+    let [n, t1, t2] = a.frame;
     let reentry = p.reentered;
     p.hist = a.hist;
     p.state = a.state;
@@ -1886,13 +1965,7 @@ fn record_pair_into<const N: usize>(a: &Active<N>, history: &mut ContactState, l
     // ½ (x[n+1] − x[n−1]) of the slave relative to the master point
     let rvec = -n * a.r_n + t1 * a.r_t.x + t2 * a.r_t.y;
     let du = (rel_prev - rel) * 0.5;
-    let work = rvec.dot(&du);
-    rec.work += work;
-    if reentry {
-        rec.reentries += 1;
-        rec.reentry_work += work.max(0.0);
-    }
-    work
+    (rvec.dot(&du), reentry)
 }
 
 impl Constraint<ContactState> for ContactSolver<'_> {
@@ -1907,13 +1980,13 @@ impl Constraint<ContactState> for ContactSolver<'_> {
         self.prepare_sweeps_into(u_next);
         let t_sweeps = now_if(timed);
         let t0 = std::time::Instant::now();
-        let (sweeps, converged, residual, worst) = self.sweep_into(u_next);
+        let (sweeps, converged, residual, worst, parallel) = self.sweep_into();
         if let Some(c) = self.sweep_threads.as_mut() {
             // the work: pairs × sweeps (the same measure in both modes)
             c.record(t0.elapsed().as_secs_f64(), (sweeps * (self.active.len() + self.mortar.active.len())) as f64);
         }
         let t_record = now_if(timed);
-        let work = penalty_work + self.record_into(history, sweeps, converged, residual, u_prev, worst.map(|k| (k, step.t_next)));
+        let work = penalty_work + self.record_into(history, u_next, sweeps, converged, residual, u_prev, worst.map(|k| (k, step.t_next)), parallel);
         if let (Some(t), Some(a), Some(b), Some(c), Some(d)) = (self.timings.as_mut(), t_search, t_prepare, t_sweeps, t_record) {
             t.search += b - a;
             t.prepare += c - b;
