@@ -202,6 +202,7 @@ bench: build
 	cargo bench --bench dam
 	cargo bench --bench motion
 	cargo bench --bench foundation
+	cargo bench --bench forkjoin
 
 # The fuzz properties of tests/all/fuzz.rs with many more cases than `make test` runs
 # (FUZZ_CASES per property, default 20000; fixed seed, so a failure reproduces).

@@ -17,6 +17,13 @@
 //! the CPU time per region of all threads (/proc/self/task/*/schedstat) above the gap's and the
 //! work's own CPU time: what the waiting and spinning of the other thread cost. Print the load
 //! average beside it: on a loaded machine the other thread may not be running.
+//!
+//! Last, the **round trip of a cache line between two threads** (a ping-pong of one atomic,
+//! 2 × 10⁶ round trips, best of 5; the operating system places the two threads, on a 2-core
+//! machine one per core): it names the kind of core pair the machine has at that moment. On the
+//! EPYC VM of docs/performance.md §7 ("Two kinds of core pair") it was 70–125 ns when the two
+//! vCPUs shared a cache and 320–380 ns when not, and the host switched between the two every
+//! few minutes: run it before and after a timing to know which one the timing saw.
 //! Run: `cargo bench --bench forkjoin`; results also in target/bench/forkjoin.json.
 
 use rayon::prelude::*;
@@ -33,6 +40,31 @@ fn spin_for(d: Duration) {
 fn cpu_s() -> f64 {
     let Ok(dir) = std::fs::read_dir("/proc/self/task") else { return f64::NAN };
     dir.flatten().filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok()).filter_map(|s| s.split_whitespace().next()?.parse::<f64>().ok()).sum::<f64>() * 1e-9
+}
+
+/// The round trip [ns] of one cache line between two threads: `n` round trips of a counter
+/// that each thread advances in turn.
+fn ping_pong_ns(n: u64) -> f64 {
+    use std::sync::atomic::{AtomicU64, Ordering::*};
+    let flag = AtomicU64::new(0);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            for i in 0..n {
+                while flag.load(Acquire) != 2 * i + 1 {
+                    std::hint::spin_loop();
+                }
+                flag.store(2 * i + 2, Release);
+            }
+        });
+        let t = Instant::now();
+        for i in 0..n {
+            flag.store(2 * i + 1, Release);
+            while flag.load(Acquire) != 2 * i + 2 {
+                std::hint::spin_loop();
+            }
+        }
+        t.elapsed().as_secs_f64() / n as f64 * 1e9
+    })
 }
 
 fn stats(v: &[f64]) -> (f64, f64) {
@@ -84,7 +116,11 @@ fn main() {
     });
     let load_after = std::fs::read_to_string("/proc/loadavg").unwrap_or_default().trim().to_string();
     println!("  load average after: {load_after}");
+    // after the cases: its threads' CPU time would otherwise count in the first case's (the
+    // process's CPU sum drops when the finished threads leave /proc/self/task)
+    let round_trip = (0..5).map(|_| ping_pong_ns(2_000_000)).fold(f64::INFINITY, f64::min);
+    println!("cache-line round trip between two threads: {round_trip:.0} ns (best of 5 × 2e6)");
     let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let _ = std::fs::create_dir_all(root.join("target/bench"));
-    let _ = std::fs::write(root.join("target/bench/forkjoin.json"), serde_json::to_string_pretty(&serde_json::json!({"threads": threads, "load_before": load, "load_after": load_after, "cases": rows})).unwrap());
+    let _ = std::fs::write(root.join("target/bench/forkjoin.json"), serde_json::to_string_pretty(&serde_json::json!({"threads": threads, "round_trip_ns": round_trip, "load_before": load, "load_after": load_after, "cases": rows})).unwrap());
 }
