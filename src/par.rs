@@ -119,15 +119,15 @@ pub const CONCAT_PAR_MIN: usize = 4096;
 
 /// A loop's choice between one thread and all the pool's threads, made by timing both: every
 /// [`Self::PERIOD`] calls a trial of [`Self::TRIAL`] calls on one thread then as many on all
-/// threads, and the rest of the period on whichever cost less per unit of work over the trial.
-/// A new pool (another thread count) first runs [`Self::WARMUP`] calls on all threads untimed. Only for a
-/// loop whose result is the same either way (bit-identical on any number of threads): the choice
-/// depends on timings, so it must never change a value.
+/// threads, and the rest of the period on whichever cost less per unit of work over the trial;
+/// a new pool (another thread count) first runs [`Self::WARMUP`] calls on all threads untimed.
+/// Only for a loop whose result is the same either way (bit-identical on any number of
+/// threads): the choice depends on timings, so it must never change a value.
 ///
 /// Why: the two vCPUs of a cloud VM may share a last-level cache or not, and the host moves them
 /// between the two placements during a run; a cache line going from one vCPU to the other then
-/// takes about 3.4× as long (a ping-pong's round trip of about 105 ns against 350 ns on the EPYC
-/// VM of docs/performance.md §7, "Two kinds of core pair"). A loop of many short regions whose
+/// takes 3–5× as long (a ping-pong's round trip of 70–125 ns against 320–380 ns on the EPYC VM
+/// of docs/performance.md §7, "Two kinds of core pair"; `cargo bench --bench forkjoin` prints it). A loop of many short regions whose
 /// data moves between the threads (the contact's Gauss–Seidel sweeps: about 50 colours a step of
 /// 10–30 µs each) gains on two threads in the first placement and loses in the second, so one
 /// choice made before the run is wrong in one of them.

@@ -48,7 +48,8 @@
 //! parallel sweeps cost more than one thread's. The result is bit-identical on any number of
 //! threads and either choice (test
 //! `contact_search_and_sweeps_in_parallel_are_bit_identical_to_one_thread`). The mortar pairs,
-//! the last colour (pairs past 63 colours) and the set-up and record stay on one thread.
+//! the last colour (pairs past 63 colours), the set-up (listing, warm start, colouring) and the
+//! joints' sums of the record stay on one thread.
 //!
 //! Penalty variant (`Method::Penalty`): same search on the positions at t[n]; normal spring
 //! kn A on the gap, tangential elastic spring kt A, with the joint law of the dynamic contact
@@ -188,7 +189,6 @@ struct MortarScratch {
 /// A penalty pair's force of step n (`Method::Penalty`): slave node, master nodes, their count,
 /// weights and the force on the slave [N].
 type PenaltyPair = (u32, [u32; 4], u8, [f64; 4], Vector3<f64>);
-
 
 /// A slice that the threads of one parallel pass read and write at disjoint places: the pairs
 /// of one colour ([`ContactSolver::order_by_color`]) and the nodes they move. Two pairs of one
@@ -472,9 +472,10 @@ pub struct ContactSolver<'m> {
     /// smaller colour's pass (about 50 ns a pair) costs no more than waking the other threads.
     /// The result does not depend on it (module doc, "Threads").
     pub sweep_par_min: usize,
-    /// Whether the sweeps run on all threads or on one, chosen by timing both every
-    /// [`crate::par::ThreadChoice::PERIOD`] steps (docs/performance.md §7, "Two kinds of core
-    /// pair": on two vCPUs that share no cache the parallel sweeps cost more than one thread's).
+    /// Whether the sweeps (and with them the record) run on all threads or on one, chosen by
+    /// timing the sweeps both ways every [`crate::par::ThreadChoice::PERIOD`] steps
+    /// (docs/performance.md §7, "Two kinds of core pair": on two vCPUs that share no cache the
+    /// parallel sweeps cost more than one thread's).
     /// Default: chosen by timing. `None`: always on all threads (tests of the parallel path).
     /// The result does not depend on it (module doc, "Threads").
     pub sweep_threads: Option<crate::par::ThreadChoice>,
