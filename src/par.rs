@@ -13,7 +13,8 @@
 //!
 //! Also [`with_awake_workers`]: a run's time loop with the pool's other workers kept awake
 //! between the step's regions; [`ThreadChoice`]: a loop's choice between one thread and all,
-//! made by timing both; [`concat_into`]: vectors concatenated on all threads.
+//! made by timing both; [`concat_into`]: vectors concatenated on all threads
+//! ([`split_lengths_mut`]: a slice cut into consecutive pieces, one per task).
 //!
 //! A leaf (std and rayon only).
 
@@ -76,6 +77,19 @@ pub fn with_awake_workers<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     })
 }
 
+/// `s` cut into consecutive pieces of the given lengths (their sum at most `s.len()`), for a
+/// parallel loop that gives each thread its own piece.
+pub fn split_lengths_mut<T>(s: &mut [T], lengths: impl IntoIterator<Item = usize>) -> Vec<&mut [T]> {
+    let mut pieces = Vec::new();
+    let mut rest = s;
+    for len in lengths {
+        let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+        pieces.push(head);
+        rest = tail;
+    }
+    pieces
+}
+
 /// The vectors `field(part)` of `parts` concatenated in order into `out` (cleared first), each
 /// part's copied by whichever thread takes that part in a parallel loop over `parts` (rayon
 /// splits the list alike each time: on two threads the caller takes the first half and the
@@ -93,13 +107,8 @@ pub fn concat_into<S: Send, T: Copy + Send + Sync>(out: &mut Vec<T>, parts: &mut
         return;
     }
     out.reserve(total);
-    let mut pieces = Vec::with_capacity(parts.len());
-    let mut rest = &mut out.spare_capacity_mut()[..total];
-    for p in parts.iter_mut() {
-        let (head, tail) = std::mem::take(&mut rest).split_at_mut(field(p).len());
-        pieces.push(head);
-        rest = tail;
-    }
+    let lengths: Vec<usize> = parts.iter_mut().map(|p| field(p).len()).collect();
+    let pieces = split_lengths_mut(&mut out.spare_capacity_mut()[..total], lengths);
     region();
     pieces.into_par_iter().zip(parts.par_iter_mut()).for_each(|(dst, p)| {
         let src = field(p);

@@ -1717,7 +1717,7 @@ impl ContactSolver<'_> {
         // round-off-sized updates otherwise ripple through every sweep.
         let mark_tol2 = (1e-2 * self.gs_tolerance).powi(2);
         let laws: Vec<JointLaw> = self.joints.iter().map(|j| self.law_in_force(j)).collect();
-        let ContactSolver { active, order, color_runs, local, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, sweep_threads, local_cuts: cuts, .. } = self;
+        let ContactSolver { active, order, color_runs, local, evaluated_at, sweep_start, gs_tolerance, gs_max_sweeps, gs_shared_passes, mob_matrix, mortar, sweep_par_min, shared_pairs, shared_runs, sweep_threads, local_cuts, .. } = self;
         let parallel = rayon::current_num_threads() > 1 && sweep_threads.as_mut().is_none_or(|c| c.parallel());
         let mut sweeps = 0;
         let pairs = active.len() + mortar.active.len();
@@ -1726,10 +1726,9 @@ impl ContactSolver<'_> {
             *x0 = l.x;
         }
         // each sweep's change by parts of the local nodes, as the colours share out the pairs
-        let mut local_cuts: Vec<usize> = std::mem::take(cuts);
         local_cuts.clear();
         if parallel {
-            local_cuts_of_into(&mut local_cuts, active, local.len(), rayon::current_num_threads());
+            local_cuts_of_into(local_cuts, active, local.len(), rayon::current_num_threads());
         }
         // Full sweeps first, the work list once it pays: while at least half the pairs moved a
         // node by more than the marking tolerance in the last sweep, a sweep evaluates every pair
@@ -1782,15 +1781,9 @@ impl ContactSolver<'_> {
             }
             let max_du = if local_cuts.len() > 2 {
                 crate::par::region();
-                let mut pieces: Vec<(&[LocalNode], &mut [Vector3<f64>])> = Vec::with_capacity(local_cuts.len() - 1);
-                let mut rest: &mut [Vector3<f64>] = sweep_start;
-                for w in local_cuts.windows(2) {
-                    let (head, tail) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
-                    pieces.push((&local[w[0]..w[1]], head));
-                    rest = tail;
-                }
+                let starts = crate::par::split_lengths_mut(sweep_start, local_cuts.windows(2).map(|w| w[1] - w[0]));
                 // the largest of the parts' largest changes: the same as one pass's
-                pieces.into_par_iter().with_max_len(1).map(|(l, s)| sweep_change_into(l, s)).reduce(|| 0.0, f64::max)
+                starts.into_par_iter().zip(local_cuts.par_windows(2)).with_max_len(1).map(|(s, w)| sweep_change_into(&local[w[0]..w[1]], s)).reduce(|| 0.0, f64::max)
             } else {
                 sweep_change_into(local, sweep_start)
             }
@@ -1800,7 +1793,6 @@ impl ContactSolver<'_> {
                 || listed && !active.iter().zip(evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e)) && !m.active.iter().zip(m.evaluated_at.iter()).any(|(a, &e)| moved_since(local, a, e));
         }
         let worst = (!converged && !before_last.is_empty()).then(|| local.iter().zip(&before_last).enumerate().map(|(k, (l, b))| (k as u32, (l.x - b).norm_squared())).fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a }).0);
-        *cuts = local_cuts;
         (sweeps, converged, residual, worst, parallel)
     }
 
@@ -1854,16 +1846,9 @@ impl ContactSolver<'_> {
         let records: Vec<Shared<PairRecord>> = history.joints.iter_mut().map(|r| Shared::of(&mut r.pairs)).collect();
         let u = Shared::of(u_next);
         let (active, local, local_global, cuts) = (&self.active, &self.local, &self.local_global, &self.local_cuts);
-        let mut pieces: Vec<(usize, &mut [(u32, f64, bool)])> = Vec::with_capacity(parts);
-        let mut rest: &mut [(u32, f64, bool)] = &mut self.pair_work;
-        for p in 0..parts {
-            let (a, b) = (n * p / parts, n * (p + 1) / parts);
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(b - a);
-            pieces.push((p, head));
-            rest = tail;
-        }
+        let pieces = crate::par::split_lengths_mut(&mut self.pair_work, (0..parts).map(|p| n * (p + 1) / parts - n * p / parts));
         crate::par::region();
-        pieces.into_par_iter().with_max_len(1).for_each(|(p, out)| {
+        pieces.into_par_iter().enumerate().with_max_len(1).for_each(|(p, out)| {
             for (l, &nd) in local[cuts[p]..cuts[p + 1]].iter().zip(&local_global[cuts[p]..cuts[p + 1]]) {
                 for d in 0..3 {
                     // SAFETY: each local node is one global node, written by its part alone
